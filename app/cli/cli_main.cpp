@@ -1,0 +1,87 @@
+// quadsketch-cli: the headless interface (interfaces.md §2).
+// Exit codes: 0 success; 2 invalid input; 3 solver failure; 1 anything else.
+#include <CLI/CLI.hpp>
+#include <iostream>
+#include <string>
+
+#include "app/cli/commands.h"
+#include "core/base/errors.h"
+
+int main(int argc, char** argv) {
+  using namespace qs::cli;
+  CLI::App app{"QuadSketch: quad layout embedding via aligned parameterization (headless)",
+               "quadsketch-cli"};
+  app.set_version_flag("--version", std::string("quadsketch-cli ") + QS_VERSION);
+  app.require_subcommand(1);
+  CommonOptions common;
+  app.add_flag("-q,--quiet", common.quiet, "Silence progress output");
+
+  ValidateOptions validate;
+  auto* cmd_validate =
+      app.add_subcommand("validate", "Check a mesh and a layout; list every problem");
+  cmd_validate->add_option("--mesh", validate.mesh, "Triangle mesh (OBJ, OFF, PLY, STL)")
+      ->required();
+  cmd_validate->add_option("--layout", validate.layout, "Layout JSON")->required();
+  cmd_validate->add_option("--out", validate.out, "Also write report.json into this folder");
+
+  FieldOptions field;
+  auto* cmd_field = app.add_subcommand("field", "Compute the guiding cross field of a layout");
+  cmd_field->add_option("--mesh", field.mesh, "Triangle mesh")->required();
+  cmd_field->add_option("--layout", field.layout, "Layout JSON")->required();
+  cmd_field->add_option("--out", field.out, "Output folder")->required();
+  cmd_field
+      ->add_option("--sharp-angle", field.sharp_angle_deg, "Sharp feature dihedral angle (deg)")
+      ->capture_default_str();
+
+  OptimizeOptions opt;
+  auto* cmd_opt = app.add_subcommand("optimize", "Run the whole pipeline and write the results");
+  cmd_opt->add_option("--mesh", opt.mesh, "Triangle mesh")->required();
+  cmd_opt->add_option("--layout", opt.layout, "Layout JSON")->required();
+  cmd_opt->add_option("--out", opt.out, "Output folder")->required();
+  cmd_opt->add_option("--steps", opt.steps, "Maximum number of node optimization steps")
+      ->capture_default_str();
+  cmd_opt->add_flag("--no-node-opt", opt.no_node_opt, "Only field and parameterization");
+  cmd_opt->add_option("--quad-size", opt.quad_size, "Write quads.obj with this quad size");
+  cmd_opt->add_option("--gradient", opt.gradient, "Node gradient: estimator or exact")
+      ->check(CLI::IsMember({"estimator", "exact"}))
+      ->capture_default_str();
+  cmd_opt->add_flag("--no-align", opt.no_align, "Ignore curvature directions (baseline)");
+  cmd_opt->add_flag("--discrete-relocation", opt.discrete_relocation,
+                    "Move nodes vertex by vertex (baseline)");
+  cmd_opt->add_option("--sharp-angle", opt.sharp_angle_deg, "Sharp feature dihedral angle (deg)")
+      ->capture_default_str();
+  cmd_opt->add_option("--threads", opt.threads, "Number of threads")->capture_default_str();
+
+  ImportQuadsOptions imp;
+  auto* cmd_import = app.add_subcommand("import-quads", "Make a layout from a quad mesh");
+  cmd_import->add_option("--quads", imp.quads, "Quad mesh")->required();
+  cmd_import->add_option("--onto", imp.onto, "Triangle mesh to transfer the layout onto");
+  cmd_import->add_option("--out", imp.out, "Output folder")->required();
+
+  PerturbOptions perturb;
+  auto* cmd_perturb = app.add_subcommand("perturb", "Move the nodes of a layout randomly");
+  cmd_perturb->add_option("--mesh", perturb.mesh, "Triangle mesh")->required();
+  cmd_perturb->add_option("--layout", perturb.layout, "Layout JSON")->required();
+  cmd_perturb->add_option("--rings", perturb.rings, "Edge rings to move each node")->required();
+  cmd_perturb->add_option("--seed", perturb.seed, "Random seed")->required();
+  cmd_perturb->add_option("--out", perturb.out, "Output layout JSON")->required();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 1;
+  }
+
+  try {
+    if (*cmd_validate) return run_validate(validate, common);
+    if (*cmd_field) return run_field(field, common);
+    if (*cmd_opt) return run_optimize(opt, common);
+    if (*cmd_import) return run_import_quads(imp, common);
+    if (*cmd_perturb) return run_perturb(perturb, common);
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return qs::exit_code_for(e);
+  }
+  return 1;
+}

@@ -1,0 +1,181 @@
+#include "app/cli/commands.h"
+
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "core/base/atomic_file.h"
+#include "core/base/errors.h"
+#include "core/layout/layout_io.h"
+#include "core/layout/validate.h"
+#include "core/mesh/mesh_io.h"
+#include "core/pipeline/pipeline.h"
+
+namespace qs::cli {
+
+namespace {
+
+int not_implemented(const std::string& command, const std::string& issue) {
+  std::cerr << "error: quadsketch-cli " << command << " is not implemented yet (tracked in issue "
+            << issue << ")\n";
+  return 1;
+}
+
+nlohmann::json mesh_json(const MeshReport& r) {
+  return {{"vertices", r.vertices},
+          {"faces", r.faces},
+          {"genus", r.genus},
+          {"boundaries", r.boundary_loops}};
+}
+
+}  // namespace
+
+int run_validate(const ValidateOptions& o, const CommonOptions& common) {
+  MeshReport report;
+  const TriMesh mesh = load_mesh(o.mesh, &report);
+  for (const auto& w : report.warnings) std::cerr << "warning: " << o.mesh << ": " << w << "\n";
+  const Layout layout = load_layout(o.layout, mesh);
+  const ValidationResult result = validate_layout(mesh, layout);
+  for (const auto& issue : result.issues)
+    std::cerr << o.layout << ": " << format_issue(issue) << "\n";
+
+  nlohmann::json out = {{"status", result.valid() ? "ok" : "invalid"},
+                        {"mesh", mesh_json(report)},
+                        {"errors", result.errors()},
+                        {"warnings", result.warnings()}};
+  nlohmann::json issues = nlohmann::json::array();
+  for (const auto& i : result.issues) {
+    issues.push_back({{"severity", i.severity == IssueSeverity::Error ? "error" : "warning"},
+                      {"code", i.code},
+                      {"message", i.message},
+                      {"nodes", i.node_ids},
+                      {"arcs", i.arc_ids},
+                      {"vertices", i.vertices}});
+  }
+  out["issues"] = issues;
+  if (result.valid()) {
+    const LayoutTopology topo = build_topology(mesh, layout);
+    int irregular = 0;
+    for (int v : topo.valence) irregular += (v != 4);
+    out["layout"] = {{"nodes", topo.num_nodes},
+                     {"arcs", topo.num_arcs},
+                     {"patches", topo.patches.size()},
+                     {"irregular_nodes", irregular}};
+    if (!common.quiet) {
+      std::cout << "valid: " << o.layout << " on " << o.mesh << " (" << report.vertices
+                << " vertices, " << report.faces << " faces, genus " << report.genus << ", "
+                << report.boundary_loops << " boundary loops): " << topo.num_nodes << " nodes ("
+                << irregular << " irregular), " << topo.num_arcs << " arcs, " << topo.patches.size()
+                << " patches";
+      if (result.warnings()) std::cout << ", " << result.warnings() << " warning(s)";
+      std::cout << "\n";
+    }
+  } else {
+    std::cerr << o.layout << ": invalid layout: " << result.errors() << " error(s)\n";
+  }
+  if (!o.out.empty()) {
+    std::filesystem::create_directories(o.out);
+    write_file_atomic((std::filesystem::path(o.out) / "report.json").string(), out.dump(2) + "\n");
+  }
+  return result.valid() ? 0 : 2;
+}
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Runs a command that writes into an output folder: report.json is written also on failure,
+// with "status": "failed" and the message, before the error propagates.
+template <typename Body>
+int with_report(const std::string& out_dir, Body&& body) {
+  std::filesystem::create_directories(out_dir);
+  const std::string report_path = (std::filesystem::path(out_dir) / "report.json").string();
+  nlohmann::json report;
+  try {
+    body(report);
+    report["status"] = "ok";
+    write_file_atomic(report_path, report.dump(2) + "\n");
+    return 0;
+  } catch (const std::exception& e) {
+    report["status"] = "failed";
+    report["message"] = e.what();
+    try {
+      write_file_atomic(report_path, report.dump(2) + "\n");
+    } catch (...) {
+    }
+    throw;
+  }
+}
+
+nlohmann::json layout_json(const LayoutTopology& topo) {
+  int irregular = 0;
+  for (int v : topo.valence) irregular += (v != 4);
+  return {{"nodes", topo.num_nodes},
+          {"arcs", topo.num_arcs},
+          {"patches", topo.patches.size()},
+          {"irregular_nodes", irregular}};
+}
+
+}  // namespace
+
+int run_field(const FieldOptions& o, const CommonOptions& common) {
+  return with_report(o.out, [&](nlohmann::json& report) {
+    const auto t_total = std::chrono::steady_clock::now();
+    auto t0 = t_total;
+    MeshReport mesh_report;
+    TriMesh mesh = load_mesh(o.mesh, &mesh_report);
+    Layout layout = load_layout(o.layout, mesh);
+    report["mesh"] = mesh_json(mesh_report);
+    const double load_s = seconds_since(t0);
+    PipelineOptions options;
+    options.field.constraints.sharp_angle_deg = o.sharp_angle_deg;
+    Pipeline pipeline(std::move(mesh), std::move(layout), options);
+    report["layout"] = layout_json(pipeline.topology());
+    t0 = std::chrono::steady_clock::now();
+    const CrossField& field = pipeline.compute_field();
+    const double field_s = seconds_since(t0);
+    nlohmann::json singularities = nlohmann::json::array();
+    for (const auto& s : pipeline.singularities())
+      singularities.push_back({{"vertex", s.vertex}, {"index", s.quarter_index / 4.0}});
+    report["singularities"] = singularities;
+    report["constraints"] = {{"curvature", field.constraints.count(ConstraintKind::Curvature)},
+                             {"feature", field.constraints.count(ConstraintKind::Feature)},
+                             {"boundary", field.constraints.count(ConstraintKind::Boundary)},
+                             {"clusters", field.clusters}};
+    report["period_jumps"] = {{"free_unknowns", field.topology.free_unknowns},
+                              {"layout_cycles", field.topology.cycles},
+                              {"max_abs", field.topology.max_abs_jump}};
+    write_field_txt(pipeline.geometry(), field.theta,
+                    (std::filesystem::path(o.out) / "field.txt").string());
+    report["timings_s"] = {{"load", load_s},
+                           {"field", field_s},
+                           {"curvature", field.timings.curvature_s},
+                           {"period_jumps", field.timings.period_jumps_s},
+                           {"assemble", field.timings.assemble_s},
+                           {"factorize", field.timings.factorize_s},
+                           {"solve", field.timings.solve_s},
+                           {"total", seconds_since(t_total)}};
+    if (!common.quiet) {
+      std::cerr << "field: " << pipeline.singularities().size() << " singular vertices, "
+                << field.constraints.face.size() << " constrained faces, " << field_s
+                << " s; wrote " << o.out << "/field.txt and report.json\n";
+    }
+  });
+}
+
+int run_optimize(const OptimizeOptions&, const CommonOptions&) {
+  return not_implemented("optimize", "#4 and #5");
+}
+
+int run_import_quads(const ImportQuadsOptions&, const CommonOptions&) {
+  return not_implemented("import-quads", "#6");
+}
+
+int run_perturb(const PerturbOptions&, const CommonOptions&) {
+  return not_implemented("perturb", "#6");
+}
+
+}  // namespace qs::cli

@@ -1,0 +1,50 @@
+// The subcommands of quadsketch-cli. Each returns the process exit code and may throw
+// qs::QsError (mapped to exit codes by qs::exit_code_for).
+#pragma once
+
+#include <string>
+
+namespace qs::cli {
+
+struct CommonOptions {
+  bool quiet = false;
+};
+
+struct ValidateOptions {
+  std::string mesh, layout, out;
+};
+
+struct FieldOptions {
+  std::string mesh, layout, out;
+  double sharp_angle_deg = 35.0;
+};
+
+struct OptimizeOptions {
+  std::string mesh, layout, out;
+  int steps = 25;
+  bool no_node_opt = false;
+  double quad_size = 0.0;
+  std::string gradient = "estimator";
+  bool no_align = false;
+  bool discrete_relocation = false;
+  double sharp_angle_deg = 35.0;
+  int threads = 2;
+};
+
+struct ImportQuadsOptions {
+  std::string quads, onto, out;
+};
+
+struct PerturbOptions {
+  std::string mesh, layout, out;
+  int rings = 1;
+  unsigned seed = 0;
+};
+
+int run_validate(const ValidateOptions& options, const CommonOptions& common);
+int run_field(const FieldOptions& options, const CommonOptions& common);
+int run_optimize(const OptimizeOptions& options, const CommonOptions& common);
+int run_import_quads(const ImportQuadsOptions& options, const CommonOptions& common);
+int run_perturb(const PerturbOptions& options, const CommonOptions& common);
+
+}  // namespace qs::cli

@@ -1,0 +1,159 @@
+// The QuadSketch editor: window, main loop, input routing, tools and panels.
+// app.cpp: window and loop; input.cpp: camera and sketch tools; panels.cpp: ImGui panels.
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/gui/autosave.h"
+#include "app/gui/document.h"
+#include "app/gui/recent_files.h"
+#include "core/pipeline/worker.h"
+#include "render/background.h"
+#include "render/camera.h"
+#include "render/layout_layer.h"
+#include "render/mesh_layer.h"
+#include "render/picking.h"
+
+struct GLFWwindow;
+
+namespace qs::app {
+
+//! Command-line options (interfaces.md §3).
+struct AppOptions {
+  std::string mesh_path;    //!< "" -> bundled example
+  std::string layout_path;  //!< "" -> bundled example layout (with the example mesh only)
+  bool run = false;
+  std::string screenshot_path;
+  int frames = 0;  //!< 0: not given
+  bool quit = false;
+  int width = 1280;
+  int height = 800;
+};
+
+enum class Tool { Select, PlaceNode, DrawArc, Split, Delete, Pin };
+
+class App {
+ public:
+  explicit App(AppOptions options);
+  ~App();
+  //! Runs until the window closes (or --quit). Returns the process exit code.
+  int run();
+
+  // GLFW callbacks (static trampolines find the App through the window user pointer).
+  void on_key(int key, int mods, int action);
+  void on_drop(int count, const char** paths);
+
+ private:
+  bool init_window();
+  void init_imgui();
+  void shutdown();
+  bool load_initial_files();
+  void frame();
+  void render_scene(int fb_width, int fb_height);
+  void poll_worker();
+  bool automation() const { return !options_.screenshot_path.empty() || options_.quit; }
+
+  // Files (app.cpp).
+  void open_mesh(const std::string& path);
+  void open_layout(const std::string& path);
+  void after_layout_replaced();
+  void save_layout(const std::string& path);
+  void report_error(const std::string& message);
+  void on_layout_edited(const Layout& layout);
+
+  // Input and tools (input.cpp).
+  void handle_mouse();
+  void handle_keys();
+  void update_hover(const glm::vec2& mouse);
+  void click(const glm::vec2& mouse);
+  int pick_node(const glm::vec2& mouse, float radius_px) const;
+  int pick_arc(const glm::vec2& mouse, float radius_px) const;
+  std::optional<render::SurfaceHit> pick_surface(const glm::vec2& mouse) const;
+  glm::vec3 vertex_position(int v) const;
+  void apply(const EditResult& result, const std::string& done_message);
+  void focus_selection();
+  void focus_vertices(const std::vector<int>& vertices);
+  void reset_view();
+  void undo();
+  void redo();
+  void delete_selection();
+  void toggle_pin_selection();
+  void set_tool(Tool tool);
+
+  // Panels (panels.cpp).
+  void draw_ui();
+  void draw_main_panel();
+  void draw_files_section();
+  void draw_tools_section();
+  void draw_view_section();
+  void draw_layout_section();
+  void draw_validation_section();
+  void draw_pipeline_section();
+  void draw_error_panel();
+  void draw_autosave_prompt();
+  void draw_status_bar();
+  void draw_legend();
+
+  AppOptions options_;
+  GLFWwindow* window_ = nullptr;
+  bool imgui_ready_ = false;
+
+  Document doc_;
+  RecentFiles recent_;
+  std::unique_ptr<Worker> worker_;
+  SnapshotPtr snapshot_;
+  std::uint64_t snapshot_version_ = ~0ull;
+  std::uint64_t param_version_ = 0;
+
+  render::Camera camera_;
+  render::SurfacePicker picker_;
+  std::unique_ptr<render::Background> background_;
+  std::unique_ptr<render::MeshLayer> mesh_layer_;
+  std::unique_ptr<render::LayoutLayer> layout_layer_;
+  std::uint64_t picker_mesh_version_ = ~0ull;
+
+  // Interaction state.
+  Tool tool_ = Tool::Select;
+  int selected_node_ = -1;
+  int selected_arc_ = -1;
+  int hovered_node_ = -1;
+  int hovered_arc_ = -1;
+  int hovered_vertex_ = -1;
+  int arc_start_node_ = -1;
+  std::vector<int> preview_path_;
+  int preview_target_vertex_ = -1;
+  std::uint64_t interaction_version_ = 0;
+  enum class Drag { None, Pending, Orbit, Pan, MoveNode } drag_ = Drag::None;
+  glm::vec2 press_pos_{0.0f};
+  glm::vec2 last_mouse_{-1.0f};
+  int press_node_ = -1;
+  std::vector<std::pair<int, int>> key_events_;  // (key, mods) presses
+  std::vector<std::string> dropped_files_;
+
+  // UI state.
+  std::string mesh_field_;
+  std::string layout_field_;
+  std::string save_field_;
+  std::vector<std::string> errors_;
+  std::string status_;
+  std::optional<AutosaveOffer> autosave_offer_;
+  std::string autosave_error_;
+  int highlighted_issue_ = -1;
+  bool show_demo_ = false;
+  std::string shader_log_;
+
+  // Automation and timing.
+  int frame_count_ = 0;
+  std::chrono::steady_clock::time_point start_time_;
+  std::chrono::steady_clock::time_point first_frame_;
+  bool run_requested_ = false;
+  int frames_since_run_done_ = -1;
+  int exit_code_ = 0;
+  bool quit_now_ = false;
+};
+
+}  // namespace qs::app

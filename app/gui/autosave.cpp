@@ -1,0 +1,75 @@
+#include "app/gui/autosave.h"
+
+#include <chrono>
+#include <cstdlib>
+#include <ctime>
+#include <nlohmann/json.hpp>
+
+#include "core/base/atomic_file.h"
+#include "core/layout/layout_io.h"
+
+namespace qs::app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path meta_path() { return autosave_dir() / "autosave.meta.json"; }
+
+std::string absolute_string(const std::string& path) {
+  if (path.empty()) return {};
+  std::error_code ec;
+  const fs::path p = fs::weakly_canonical(fs::absolute(path, ec), ec);
+  return ec ? path : p.string();
+}
+
+}  // namespace
+
+fs::path autosave_dir() {
+  if (const char* dir = std::getenv("QS_AUTOSAVE_DIR"); dir && *dir) return dir;
+  if (const char* cache = std::getenv("XDG_CACHE_HOME"); cache && *cache)
+    return fs::path(cache) / "quadsketch";
+  if (const char* home = std::getenv("HOME"); home && *home)
+    return fs::path(home) / ".cache" / "quadsketch";
+  return fs::temp_directory_path() / "quadsketch";
+}
+
+fs::path autosave_path() { return autosave_dir() / "autosave.layout.json"; }
+
+void write_autosave(const Layout& layout, const TriMesh* mesh, const std::string& mesh_path,
+                    const std::string& layout_path) {
+  fs::create_directories(autosave_dir());
+  save_layout(layout, autosave_path().string(), mesh);
+  const std::time_t now = std::time(nullptr);
+  char stamp[64] = "";
+  std::strftime(stamp, sizeof(stamp), "%Y-%m-%d %H:%M:%S", std::localtime(&now));
+  const nlohmann::json meta = {{"mesh", absolute_string(mesh_path)},
+                               {"layout", absolute_string(layout_path)},
+                               {"saved_at", stamp}};
+  write_file_atomic(meta_path().string(), meta.dump(2) + "\n");
+}
+
+std::optional<AutosaveOffer> find_autosave(const std::string& mesh_path,
+                                           const std::string& layout_path) {
+  try {
+    std::error_code ec;
+    const fs::path autosave = autosave_path();
+    if (!fs::exists(autosave, ec) || !fs::exists(meta_path(), ec)) return std::nullopt;
+    const auto meta = nlohmann::json::parse(read_file(meta_path().string()));
+    if (meta.value("mesh", std::string()) != absolute_string(mesh_path)) return std::nullopt;
+    AutosaveOffer offer;
+    offer.path = autosave;
+    offer.layout_path = meta.value("layout", std::string());
+    offer.saved_at = meta.value("saved_at", std::string());
+    if (!layout_path.empty() && fs::exists(layout_path, ec)) {
+      if (offer.layout_path != absolute_string(layout_path)) return std::nullopt;
+      if (fs::last_write_time(autosave, ec) <= fs::last_write_time(layout_path, ec))
+        return std::nullopt;
+    }
+    return offer;
+  } catch (const std::exception&) {
+    return std::nullopt;  // a corrupt sidecar is not worth an error at start-up
+  }
+}
+
+}  // namespace qs::app

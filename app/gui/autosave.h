@@ -1,0 +1,35 @@
+// Crash safety: after every edit the layout is written atomically to an autosave file, with
+// a small sidecar naming the mesh it belongs to, so that it can be offered back at start.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "core/layout/layout.h"
+#include "core/mesh/mesh.h"
+
+namespace qs::app {
+
+//! $QS_AUTOSAVE_DIR if set (tests), else $XDG_CACHE_HOME/quadsketch, else ~/.cache/quadsketch.
+std::filesystem::path autosave_dir();
+//! autosave_dir()/autosave.layout.json
+std::filesystem::path autosave_path();
+
+//! Writes the layout (atomically) and the sidecar autosave.meta.json. \p mesh_path and
+//! \p layout_path are the files being edited. \throw QsError when the folder is not writable.
+void write_autosave(const Layout& layout, const TriMesh* mesh, const std::string& mesh_path,
+                    const std::string& layout_path);
+
+struct AutosaveOffer {
+  std::filesystem::path path;  //!< the autosave layout
+  std::string layout_path;     //!< the file it was editing ("" for a new layout)
+  std::string saved_at;        //!< local time, for the prompt
+};
+
+//! An autosave worth offering for \p mesh_path: made for the same mesh file and newer than
+//! \p layout_path (or any, when \p layout_path is empty or missing). Never throws.
+std::optional<AutosaveOffer> find_autosave(const std::string& mesh_path,
+                                           const std::string& layout_path);
+
+}  // namespace qs::app

@@ -1,0 +1,350 @@
+#include "app/gui/layout_editor.h"
+
+#include <algorithm>
+#include <utility>
+
+#include "core/layout/routing.h"
+
+namespace qs::app {
+
+namespace {
+
+// An edited arc no longer matches anything the optimizer traced for it.
+void clear_arc_outputs(LayoutArc& arc) {
+  arc.label.clear();
+  arc.polyline.clear();
+  arc.samples.clear();
+  arc.points.clear();
+}
+
+void clear_node_outputs(LayoutNode& node) {
+  node.point.reset();  // a stale `point` would snap the node back when the file is reloaded
+  node.position.reset();
+  node.valence = -1;
+}
+
+bool valid_vertex(const TriMesh& mesh, int v) { return v >= 0 && v < int(mesh.n_vertices()); }
+
+}  // namespace
+
+int next_node_id(const Layout& layout) {
+  int id = 0;
+  for (const auto& n : layout.nodes) id = std::max(id, n.id + 1);
+  return id;
+}
+
+int next_arc_id(const Layout& layout) {
+  int id = 0;
+  for (const auto& a : layout.arcs) id = std::max(id, a.id + 1);
+  return id;
+}
+
+int node_at_vertex(const Layout& layout, int vertex) {
+  for (const auto& n : layout.nodes)
+    if (n.vertex == vertex) return n.id;
+  return -1;
+}
+
+int arc_through_vertex(const Layout& layout, int vertex) {
+  for (const auto& a : layout.arcs)
+    for (std::size_t i = 1; i + 1 < a.path.size(); ++i)
+      if (a.path[i] == vertex) return a.id;
+  // A dangling arc's boundary end is not a node either.
+  for (const auto& a : layout.arcs)
+    if (a.dangling() && !a.path.empty() && a.path.back() == vertex) return a.id;
+  return -1;
+}
+
+int node_valence(const Layout& layout, int node_id) {
+  int valence = 0;
+  for (const auto& a : layout.arcs) valence += (a.from == node_id) + (a.to == node_id);
+  return valence;
+}
+
+void LayoutEditor::reset(const TriMesh* mesh, Layout layout) {
+  mesh_ = mesh;
+  history_.clear();
+  cursor_ = 0;
+  drag_node_ = -1;
+  set_layout(std::move(layout));
+}
+
+void LayoutEditor::set_layout(Layout layout) {
+  layout_ = std::move(layout);
+  ++version_;
+}
+
+void LayoutEditor::commit(std::string label, Layout before) {
+  history_.resize(cursor_);  // a new edit drops the redo branch
+  history_.push_back({std::move(label), std::move(before), layout_});
+  if (history_.size() > max_history) history_.erase(history_.begin());
+  cursor_ = history_.size();
+  ++version_;
+  if (on_change) on_change(layout_);
+}
+
+EditResult LayoutEditor::check_mesh() const {
+  if (!mesh_) return EditResult::fail("no mesh loaded");
+  if (dragging()) return EditResult::fail("finish the drag first");
+  return {};
+}
+
+bool LayoutEditor::reroute_arcs_of(Layout& layout, int node_id, std::string* error) const {
+  // Remove the node's arcs, then route them back one by one so that each new path avoids
+  // all other arcs and the ones already re-routed.
+  std::vector<LayoutArc> moved;
+  std::erase_if(layout.arcs, [&](const LayoutArc& a) {
+    if (a.from != node_id && a.to != node_id) return false;
+    moved.push_back(a);
+    return true;
+  });
+  for (auto& arc : moved) {
+    const int from = layout.node_index(arc.from);
+    const int to = arc.dangling() ? -1 : layout.node_index(arc.to);
+    if (from < 0 || (!arc.dangling() && to < 0)) {
+      if (error) *error = "arc " + std::to_string(arc.id) + " has a missing end node";
+      return false;
+    }
+    const RoutingObstacles obstacles = obstacles_of_layout(*mesh_, layout);
+    const int source = layout.nodes[from].vertex;
+    std::vector<int> path =
+        arc.dangling() ? shortest_path_to_boundary(*mesh_, source, obstacles)
+                       : shortest_path(*mesh_, source, layout.nodes[to].vertex, obstacles);
+    if (path.size() < 2) {
+      if (error) *error = "arc " + std::to_string(arc.id) + " cannot be routed (no free path)";
+      return false;
+    }
+    arc.path = std::move(path);
+    clear_arc_outputs(arc);
+    layout.arcs.push_back(std::move(arc));
+  }
+  // Keep the file order stable (sorted by id) so that saved layouts diff nicely.
+  std::sort(layout.arcs.begin(), layout.arcs.end(),
+            [](const LayoutArc& a, const LayoutArc& b) { return a.id < b.id; });
+  return true;
+}
+
+EditResult LayoutEditor::add_node(int vertex) {
+  if (auto r = check_mesh(); !r) return r;
+  if (!valid_vertex(*mesh_, vertex)) return EditResult::fail("vertex out of range");
+  if (int id = node_at_vertex(layout_, vertex); id >= 0)
+    return EditResult::fail("vertex " + std::to_string(vertex) + " already holds node " +
+                            std::to_string(id));
+  if (int arc = arc_through_vertex(layout_, vertex); arc >= 0)
+    return EditResult::fail("vertex " + std::to_string(vertex) + " lies on arc " +
+                            std::to_string(arc) + " (split the arc instead)");
+  Layout before = layout_;
+  LayoutNode node;
+  node.id = next_node_id(layout_);
+  node.vertex = vertex;
+  layout_.nodes.push_back(node);
+  layout_.patches.clear();
+  commit("add node " + std::to_string(node.id), std::move(before));
+  return {true, {}, node.id};
+}
+
+EditResult LayoutEditor::add_arc(int from_id, int to_id) {
+  if (auto r = check_mesh(); !r) return r;
+  const int from = layout_.node_index(from_id);
+  const int to = layout_.node_index(to_id);
+  if (from < 0 || to < 0) return EditResult::fail("unknown node");
+  if (from_id == to_id) return EditResult::fail("an arc needs two different nodes");
+  const RoutingObstacles obstacles = obstacles_of_layout(*mesh_, layout_);
+  std::vector<int> path =
+      shortest_path(*mesh_, layout_.nodes[from].vertex, layout_.nodes[to].vertex, obstacles);
+  if (path.size() < 2)
+    return EditResult::fail("no free path from node " + std::to_string(from_id) + " to node " +
+                            std::to_string(to_id) + " (other arcs are in the way)");
+  Layout before = layout_;
+  LayoutArc arc;
+  arc.id = next_arc_id(layout_);
+  arc.from = from_id;
+  arc.to = to_id;
+  arc.path = std::move(path);
+  layout_.arcs.push_back(std::move(arc));
+  layout_.patches.clear();
+  const int id = layout_.arcs.back().id;
+  commit("add arc " + std::to_string(id), std::move(before));
+  return {true, {}, id};
+}
+
+EditResult LayoutEditor::delete_node(int id) {
+  if (auto r = check_mesh(); !r) return r;
+  const int index = layout_.node_index(id);
+  if (index < 0) return EditResult::fail("unknown node " + std::to_string(id));
+  Layout before = layout_;
+  layout_.nodes.erase(layout_.nodes.begin() + index);
+  std::erase_if(layout_.arcs, [&](const LayoutArc& a) { return a.from == id || a.to == id; });
+  layout_.patches.clear();
+  commit("delete node " + std::to_string(id), std::move(before));
+  return {};
+}
+
+EditResult LayoutEditor::delete_arc(int id) {
+  if (auto r = check_mesh(); !r) return r;
+  const int index = layout_.arc_index(id);
+  if (index < 0) return EditResult::fail("unknown arc " + std::to_string(id));
+  Layout before = layout_;
+  layout_.arcs.erase(layout_.arcs.begin() + index);
+  layout_.patches.clear();
+  commit("delete arc " + std::to_string(id), std::move(before));
+  return {};
+}
+
+EditResult LayoutEditor::move_node(int id, int vertex) {
+  if (auto r = check_mesh(); !r) return r;
+  const int index = layout_.node_index(id);
+  if (index < 0) return EditResult::fail("unknown node " + std::to_string(id));
+  if (!valid_vertex(*mesh_, vertex)) return EditResult::fail("vertex out of range");
+  if (layout_.nodes[index].vertex == vertex) return EditResult::fail("the node is already there");
+  const int other = node_at_vertex(layout_, vertex);
+  if (other >= 0) return EditResult::fail("vertex holds node " + std::to_string(other));
+  Layout moved = layout_;
+  {  // the node's own arcs may pass through the new vertex: they are re-routed anyway
+    Layout without_own = layout_;
+    std::erase_if(without_own.arcs,
+                  [&](const LayoutArc& a) { return a.from == id || a.to == id; });
+    if (int arc = arc_through_vertex(without_own, vertex); arc >= 0)
+      return EditResult::fail("vertex lies on arc " + std::to_string(arc));
+  }
+  moved.nodes[index].vertex = vertex;
+  clear_node_outputs(moved.nodes[index]);
+  std::string error;
+  if (!reroute_arcs_of(moved, id, &error)) return EditResult::fail(error);
+  moved.patches.clear();
+  Layout before = std::move(layout_);
+  layout_ = std::move(moved);
+  commit("move node " + std::to_string(id), std::move(before));
+  return {};
+}
+
+EditResult LayoutEditor::split_arc(int arc_id, int vertex) {
+  if (auto r = check_mesh(); !r) return r;
+  const int index = layout_.arc_index(arc_id);
+  if (index < 0) return EditResult::fail("unknown arc " + std::to_string(arc_id));
+  const auto& path = layout_.arcs[index].path;
+  const auto it = std::find(path.begin(), path.end(), vertex);
+  if (it == path.end() || it == path.begin() || it + 1 == path.end())
+    return EditResult::fail("split needs an interior vertex of arc " + std::to_string(arc_id));
+  const std::size_t k = static_cast<std::size_t>(it - path.begin());
+
+  Layout before = layout_;
+  LayoutNode node;
+  node.id = next_node_id(layout_);
+  node.vertex = vertex;
+  LayoutArc second = layout_.arcs[index];
+  second.id = next_arc_id(layout_);
+  second.from = node.id;
+  second.path.assign(path.begin() + static_cast<long>(k), path.end());
+  clear_arc_outputs(second);
+  LayoutArc& first = layout_.arcs[index];
+  first.to = node.id;
+  first.path.resize(k + 1);
+  clear_arc_outputs(first);
+  layout_.nodes.push_back(node);
+  layout_.arcs.push_back(std::move(second));
+  layout_.patches.clear();
+  commit("split arc " + std::to_string(arc_id), std::move(before));
+  return {true, {}, node.id};
+}
+
+EditResult LayoutEditor::toggle_node_pin(int id) {
+  if (auto r = check_mesh(); !r) return r;
+  const int index = layout_.node_index(id);
+  if (index < 0) return EditResult::fail("unknown node " + std::to_string(id));
+  Layout before = layout_;
+  layout_.nodes[index].pinned = !layout_.nodes[index].pinned;
+  commit(std::string(layout_.nodes[index].pinned ? "pin" : "unpin") + " node " +
+             std::to_string(id),
+         std::move(before));
+  return {};
+}
+
+EditResult LayoutEditor::toggle_arc_pin(int id) {
+  if (auto r = check_mesh(); !r) return r;
+  const int index = layout_.arc_index(id);
+  if (index < 0) return EditResult::fail("unknown arc " + std::to_string(id));
+  Layout before = layout_;
+  layout_.arcs[index].pinned = !layout_.arcs[index].pinned;
+  commit(std::string(layout_.arcs[index].pinned ? "pin" : "unpin") + " arc " +
+             std::to_string(id),
+         std::move(before));
+  return {};
+}
+
+bool LayoutEditor::begin_drag(int node_id) {
+  if (!mesh_ || dragging() || layout_.node_index(node_id) < 0) return false;
+  drag_node_ = node_id;
+  drag_before_ = layout_;
+  return true;
+}
+
+EditResult LayoutEditor::drag_to(int vertex) {
+  if (!dragging()) return EditResult::fail("not dragging");
+  const int index = layout_.node_index(drag_node_);
+  if (index < 0 || !valid_vertex(*mesh_, vertex)) return EditResult::fail("vertex out of range");
+  if (layout_.nodes[index].vertex == vertex) return {};
+  if (node_at_vertex(layout_, vertex) >= 0) return EditResult::fail("vertex holds a node");
+  // Route from the pre-drag layout each time, so that the preview does not drift with the
+  // order in which intermediate positions were visited.
+  Layout moved = drag_before_;
+  {
+    Layout without_own = drag_before_;
+    std::erase_if(without_own.arcs,
+                  [&](const LayoutArc& a) { return a.from == drag_node_ || a.to == drag_node_; });
+    if (arc_through_vertex(without_own, vertex) >= 0)
+      return EditResult::fail("vertex lies on another arc");
+  }
+  const int moved_index = moved.node_index(drag_node_);
+  moved.nodes[moved_index].vertex = vertex;
+  clear_node_outputs(moved.nodes[moved_index]);
+  std::string error;
+  if (!reroute_arcs_of(moved, drag_node_, &error)) return EditResult::fail(error);
+  moved.patches.clear();
+  set_layout(std::move(moved));
+  return {};
+}
+
+void LayoutEditor::end_drag() {
+  if (!dragging()) return;
+  const int id = drag_node_;
+  drag_node_ = -1;
+  const int before_index = drag_before_.node_index(id);
+  const int after_index = layout_.node_index(id);
+  if (before_index >= 0 && after_index >= 0 &&
+      drag_before_.nodes[before_index].vertex == layout_.nodes[after_index].vertex)
+    return;  // a click without movement is not an edit
+  commit("move node " + std::to_string(id), std::move(drag_before_));
+}
+
+void LayoutEditor::cancel_drag() {
+  if (!dragging()) return;
+  drag_node_ = -1;
+  set_layout(std::move(drag_before_));
+}
+
+bool LayoutEditor::undo() {
+  if (!can_undo() || dragging()) return false;
+  --cursor_;
+  set_layout(history_[cursor_].before);
+  if (on_change) on_change(layout_);
+  return true;
+}
+
+bool LayoutEditor::redo() {
+  if (!can_redo() || dragging()) return false;
+  set_layout(history_[cursor_].after);
+  ++cursor_;
+  if (on_change) on_change(layout_);
+  return true;
+}
+
+std::string LayoutEditor::undo_label() const {
+  return can_undo() ? history_[cursor_ - 1].label : std::string();
+}
+
+std::string LayoutEditor::redo_label() const {
+  return can_redo() ? history_[cursor_].label : std::string();
+}
+
+}  // namespace qs::app

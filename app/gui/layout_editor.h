@@ -1,0 +1,109 @@
+// Sketching edits on a layout with undo/redo. GL-free so that tests can drive it directly.
+//
+// Every edit either succeeds completely (one undo step) or leaves the layout untouched and
+// returns an error message for the status line. Undo steps store whole layouts: layouts are
+// small next to the mesh, and whole copies make "undo restores exactly" trivially true.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/layout/layout.h"
+#include "core/mesh/mesh.h"
+
+namespace qs::app {
+
+struct EditResult {
+  bool ok = true;
+  std::string error;  //!< why the edit was refused (ok == false)
+  int id = -1;        //!< id of a created node/arc, when the edit creates one
+  static EditResult fail(std::string message) { return {false, std::move(message), -1}; }
+  explicit operator bool() const { return ok; }
+};
+
+class LayoutEditor {
+ public:
+  //! Starts editing \p layout on \p mesh (which must outlive the editor's use); clears the
+  //! history. \p mesh may be null (then every edit fails).
+  void reset(const TriMesh* mesh, Layout layout);
+
+  const Layout& layout() const { return layout_; }
+  const TriMesh* mesh() const { return mesh_; }
+  //! Increments on every change of layout() (edits, drag previews, undo, redo, reset).
+  std::uint64_t version() const { return version_; }
+
+  //! New node on a mesh vertex. Refused on a vertex that already holds a node or lies on an
+  //! arc (use split_arc there).
+  EditResult add_node(int vertex);
+  //! New arc between two nodes, routed along the shortest free edge path (avoiding other
+  //! arcs and nodes).
+  EditResult add_arc(int from_id, int to_id);
+  //! Deletes a node and every arc that ends at it.
+  EditResult delete_node(int id);
+  EditResult delete_arc(int id);
+  //! Moves a node to another vertex and re-routes its arcs.
+  EditResult move_node(int id, int vertex);
+  //! Splits an arc with a new node at \p vertex, an interior vertex of its path. The first
+  //! part keeps the arc's id; the second part gets a new id (returned in EditResult::id is
+  //! the new node).
+  EditResult split_arc(int arc_id, int vertex);
+  EditResult toggle_node_pin(int id);
+  EditResult toggle_arc_pin(int id);
+
+  //! Interactive drag: previews are applied to layout() without history entries; end_drag
+  //! records a single undo step (or nothing if the node did not move).
+  bool begin_drag(int node_id);
+  EditResult drag_to(int vertex);
+  void end_drag();
+  void cancel_drag();
+  bool dragging() const { return drag_node_ >= 0; }
+
+  bool can_undo() const { return cursor_ > 0; }
+  bool can_redo() const { return cursor_ < history_.size(); }
+  bool undo();
+  bool redo();
+  std::string undo_label() const;
+  std::string redo_label() const;
+  std::size_t history_size() const { return history_.size(); }
+
+  //! Called after every committed change (edit, end of drag, undo, redo), e.g. for autosave.
+  std::function<void(const Layout&)> on_change;
+
+  //! Limit of the undo history (oldest steps are dropped).
+  std::size_t max_history = 500;
+
+ private:
+  struct Step {
+    std::string label;
+    Layout before;
+    Layout after;
+  };
+  void commit(std::string label, Layout before);
+  void set_layout(Layout layout);
+  EditResult check_mesh() const;
+  //! Re-routes every arc of \p node_id in \p layout. Returns false (layout partly changed)
+  //! when an arc cannot be routed; \p error names it.
+  bool reroute_arcs_of(Layout& layout, int node_id, std::string* error) const;
+
+  const TriMesh* mesh_ = nullptr;
+  Layout layout_;
+  std::uint64_t version_ = 0;
+  std::vector<Step> history_;
+  std::size_t cursor_ = 0;  // steps [0, cursor_) are done, [cursor_, size) can be redone
+  int drag_node_ = -1;
+  Layout drag_before_;
+};
+
+//! Next free id (max + 1) among nodes or arcs.
+int next_node_id(const Layout& layout);
+int next_arc_id(const Layout& layout);
+//! Id of the node on \p vertex, or -1.
+int node_at_vertex(const Layout& layout, int vertex);
+//! Id of an arc whose path passes through \p vertex as an interior vertex, or -1.
+int arc_through_vertex(const Layout& layout, int vertex);
+//! Arc valence per node id (dangling arcs count once at their `from` node).
+int node_valence(const Layout& layout, int node_id);
+
+}  // namespace qs::app

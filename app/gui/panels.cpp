@@ -1,0 +1,439 @@
+// ImGui panels: files, tools, view, layout info, validation, pipeline, errors, status bar.
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <imgui_stdlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "app/gui/app.h"
+#include "core/layout/layout_io.h"
+
+namespace qs::app {
+
+namespace {
+
+const ImVec4 kErrorColor(1.0f, 0.42f, 0.38f, 1.0f);
+const ImVec4 kWarningColor(1.0f, 0.80f, 0.35f, 1.0f);
+const ImVec4 kOkColor(0.45f, 0.85f, 0.50f, 1.0f);
+const ImVec4 kDimColor(0.62f, 0.65f, 0.70f, 1.0f);
+
+ImVec4 to_imvec(const glm::vec3& c) { return ImVec4(c.r, c.g, c.b, 1.0f); }
+
+void color_swatch(const char* id, const glm::vec3& color) {
+  ImGui::ColorButton(id, to_imvec(color), ImGuiColorEditFlags_NoTooltip | ImGuiColorEditFlags_NoPicker,
+                     ImVec2(ImGui::GetFontSize(), ImGui::GetFontSize()));
+}
+
+void help_marker(const char* text) {
+  ImGui::SameLine();
+  ImGui::TextDisabled("(?)");
+  if (ImGui::IsItemHovered()) {
+    ImGui::BeginTooltip();
+    ImGui::PushTextWrapPos(ImGui::GetFontSize() * 30.0f);
+    ImGui::TextUnformatted(text);
+    ImGui::PopTextWrapPos();
+    ImGui::EndTooltip();
+  }
+}
+
+std::string file_name(const std::string& path) {
+  return path.empty() ? std::string("(none)") : std::filesystem::path(path).filename().string();
+}
+
+const char* tool_name(Tool tool) {
+  switch (tool) {
+    case Tool::Select: return "Select / move";
+    case Tool::PlaceNode: return "Place node";
+    case Tool::DrawArc: return "Draw arc";
+    case Tool::Split: return "Split arc";
+    case Tool::Delete: return "Delete";
+    case Tool::Pin: return "Pin";
+  }
+  return "";
+}
+
+const char* tool_hint(Tool tool) {
+  switch (tool) {
+    case Tool::Select: return "Click a node or arc to select it; drag a node to move it.";
+    case Tool::PlaceNode: return "Click the surface to place a node (on an arc: splits it).";
+    case Tool::DrawArc: return "Click a node, then another node: the arc follows the shortest free path.";
+    case Tool::Split: return "Click an arc to split it with a new node.";
+    case Tool::Delete: return "Click a node (with its arcs) or an arc to delete it.";
+    case Tool::Pin: return "Click a node or arc to pin / unpin it.";
+  }
+  return "";
+}
+
+}  // namespace
+
+void App::draw_ui() {
+  draw_main_panel();
+  draw_error_panel();
+  draw_autosave_prompt();
+  draw_status_bar();
+  if (show_demo_) ImGui::ShowDemoWindow(&show_demo_);
+}
+
+void App::draw_main_panel() {
+  const ImGuiIO& io = ImGui::GetIO();
+  const float width = 22.0f * ImGui::GetFontSize();
+  ImGui::SetNextWindowPos(ImVec2(10.0f, 10.0f), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(width, io.DisplaySize.y - 60.0f), ImGuiCond_FirstUseEver);
+  ImGui::Begin("QuadSketch");
+  draw_files_section();
+  draw_tools_section();
+  draw_layout_section();
+  draw_validation_section();
+  draw_pipeline_section();
+  draw_view_section();
+  ImGui::End();
+}
+
+void App::draw_files_section() {
+  if (!ImGui::CollapsingHeader("Files", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  ImGui::PushID("files");
+  const float button = 4.5f * ImGui::GetFontSize();
+  ImGui::SetNextItemWidth(-button);
+  const bool mesh_enter = ImGui::InputTextWithHint("##mesh", "mesh .obj .off .ply .stl", &mesh_field_,
+                                                   ImGuiInputTextFlags_EnterReturnsTrue);
+  ImGui::SameLine();
+  if (ImGui::Button("Open##mesh", ImVec2(-1, 0)) || mesh_enter) open_mesh(mesh_field_);
+  ImGui::SetNextItemWidth(-button);
+  const bool layout_enter = ImGui::InputTextWithHint("##layout", "layout .json", &layout_field_,
+                                                     ImGuiInputTextFlags_EnterReturnsTrue);
+  ImGui::SameLine();
+  if (ImGui::Button("Open##layout", ImVec2(-1, 0)) || layout_enter) open_layout(layout_field_);
+
+  if (ImGui::Button("Recent...")) ImGui::OpenPopup("recent");
+  if (ImGui::BeginPopup("recent")) {
+    ImGui::TextDisabled("Meshes");
+    if (recent_.meshes().empty()) ImGui::TextDisabled("  (none)");
+    for (const auto& m : recent_.meshes())
+      if (ImGui::Selectable(m.c_str())) {
+        const std::string path = m;  // open_mesh reorders the list
+        ImGui::CloseCurrentPopup();
+        open_mesh(path);
+        break;
+      }
+    ImGui::Separator();
+    ImGui::TextDisabled("Layouts");
+    if (recent_.layouts().empty()) ImGui::TextDisabled("  (none)");
+    for (const auto& l : recent_.layouts())
+      if (ImGui::Selectable(l.c_str())) {
+        const std::string path = l;
+        ImGui::CloseCurrentPopup();
+        open_layout(path);
+        break;
+      }
+    ImGui::EndPopup();
+  }
+  ImGui::SameLine();
+  ImGui::TextDisabled("or drop files on the window");
+
+  ImGui::SetNextItemWidth(-button);
+  ImGui::InputTextWithHint("##save", "save layout as .json", &save_field_);
+  ImGui::SameLine();
+  if (!doc_.mesh) ImGui::BeginDisabled();
+  if (ImGui::Button("Save", ImVec2(-1, 0))) save_layout(save_field_);
+  if (!doc_.mesh) ImGui::EndDisabled();
+
+  if (doc_.mesh) {
+    ImGui::TextColored(kDimColor, "%s: %d vertices, %d faces, genus %d, %d boundary loop%s",
+                       file_name(doc_.mesh_path).c_str(), doc_.report.vertices, doc_.report.faces,
+                       doc_.report.genus, doc_.report.boundary_loops,
+                       doc_.report.boundary_loops == 1 ? "" : "s");
+    ImGui::TextColored(kDimColor, "layout: %s%s", file_name(doc_.layout_path).c_str(),
+                       doc_.dirty ? "  (modified, autosaved)" : "");
+    if (!autosave_error_.empty()) ImGui::TextColored(kWarningColor, "autosave failed: %s", autosave_error_.c_str());
+  } else {
+    ImGui::TextColored(kWarningColor, "No mesh loaded.");
+  }
+  ImGui::PopID();
+}
+
+void App::draw_tools_section() {
+  if (!ImGui::CollapsingHeader("Sketch", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  for (int i = 0; i < 6; ++i) {
+    const Tool t = static_cast<Tool>(i);
+    char label[64];
+    std::snprintf(label, sizeof(label), "%d %s", i + 1, tool_name(t));
+    if (i % 2 == 1) ImGui::SameLine(11.0f * ImGui::GetFontSize());
+    if (ImGui::RadioButton(label, tool_ == t)) set_tool(t);
+  }
+  ImGui::TextWrapped("%s", tool_hint(tool_));
+  if (!doc_.editor.can_undo()) ImGui::BeginDisabled();
+  if (ImGui::Button("Undo")) undo();
+  if (!doc_.editor.can_undo()) ImGui::EndDisabled();
+  ImGui::SameLine();
+  if (!doc_.editor.can_redo()) ImGui::BeginDisabled();
+  if (ImGui::Button("Redo")) redo();
+  if (!doc_.editor.can_redo()) ImGui::EndDisabled();
+  ImGui::SameLine();
+  if (doc_.editor.can_undo())
+    ImGui::TextColored(kDimColor, "last: %s", doc_.editor.undo_label().c_str());
+  help_marker(
+      "Mouse: left drag orbits, right/middle drag pans, wheel zooms.\n"
+      "Keys: 1-6 tools, F focus selection, R/Home reset view, Del delete, P pin, Esc cancel,\n"
+      "Ctrl+Z undo, Ctrl+Shift+Z / Ctrl+Y redo, Ctrl+S save.");
+}
+
+void App::draw_layout_section() {
+  if (!ImGui::CollapsingHeader("Layout", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  const Layout& layout = doc_.editor.layout();
+  int irregular = 0, pinned_nodes = 0, pinned_arcs = 0, dangling = 0;
+  for (const auto& n : layout.nodes) {
+    if (node_valence(layout, n.id) != 4) ++irregular;
+    pinned_nodes += n.pinned;
+  }
+  for (const auto& a : layout.arcs) {
+    pinned_arcs += a.pinned;
+    dangling += a.dangling();
+  }
+  if (ImGui::BeginTable("counts", 4, ImGuiTableFlags_SizingStretchSame)) {
+    ImGui::TableNextColumn();
+    ImGui::Text("nodes %zu", layout.nodes.size());
+    ImGui::TableNextColumn();
+    ImGui::Text("arcs %zu", layout.arcs.size());
+    ImGui::TableNextColumn();
+    ImGui::Text("irregular %d", irregular);
+    ImGui::TableNextColumn();
+    ImGui::Text("pinned %d", pinned_nodes + pinned_arcs);
+    ImGui::EndTable();
+  }
+  if (dangling > 0 || !layout.patches.empty())
+    ImGui::TextColored(kDimColor, "%d dangling arcs, %zu patches", dangling, layout.patches.size());
+  if (selected_node_ >= 0 && layout.node_index(selected_node_) >= 0) {
+    const auto& n = layout.nodes[layout.node_index(selected_node_)];
+    ImGui::Text("Node %d: vertex %d, valence %d%s", n.id, n.vertex, node_valence(layout, n.id),
+                n.pinned ? ", pinned" : "");
+  } else if (selected_arc_ >= 0 && layout.arc_index(selected_arc_) >= 0) {
+    const auto& a = layout.arcs[layout.arc_index(selected_arc_)];
+    ImGui::Text("Arc %d: nodes %d -> %s, %zu edges, label %s%s", a.id, a.from,
+                a.dangling() ? "boundary" : std::to_string(a.to).c_str(),
+                a.path.empty() ? 0 : a.path.size() - 1, a.label.empty() ? "?" : a.label.c_str(),
+                a.pinned ? ", pinned" : "");
+  } else {
+    ImGui::TextDisabled("Nothing selected.");
+  }
+}
+
+void App::draw_validation_section() {
+  const auto& v = doc_.validation;
+  char header[96];
+  std::snprintf(header, sizeof(header), "Validation (%d errors, %d warnings)###validation",
+                v.errors(), v.warnings());
+  if (!ImGui::CollapsingHeader(header, ImGuiTreeNodeFlags_DefaultOpen)) return;
+  if (!doc_.mesh) {
+    ImGui::TextDisabled("No mesh.");
+    return;
+  }
+  if (v.issues.empty()) {
+    ImGui::TextColored(kOkColor, "The layout is valid.");
+    return;
+  }
+  const float height = std::min(10.0f, float(v.issues.size()) + 0.5f) * ImGui::GetTextLineHeightWithSpacing();
+  ImGui::BeginChild("issues", ImVec2(0, height), true);
+  for (int i = 0; i < int(v.issues.size()); ++i) {
+    const auto& issue = v.issues[i];
+    const bool error = issue.severity == IssueSeverity::Error;
+    ImGui::PushID(i);
+    ImGui::PushStyleColor(ImGuiCol_Text, error ? kErrorColor : kWarningColor);
+    const std::string label = std::string(error ? "E " : "W ") + issue.message;
+    if (ImGui::Selectable(label.c_str(), highlighted_issue_ == i)) {
+      highlighted_issue_ = i;
+      // Focus on the problem: its vertices, or the nodes/arcs it names.
+      std::vector<int> vertices = issue.vertices;
+      const Layout& layout = doc_.editor.layout();
+      for (int id : issue.node_ids)
+        if (int k = layout.node_index(id); k >= 0) vertices.push_back(layout.nodes[k].vertex);
+      for (int id : issue.arc_ids)
+        if (int k = layout.arc_index(id); k >= 0)
+          vertices.insert(vertices.end(), layout.arcs[k].path.begin(), layout.arcs[k].path.end());
+      focus_vertices(vertices);
+      selected_node_ = issue.node_ids.size() == 1 ? issue.node_ids[0] : -1;
+      selected_arc_ = issue.arc_ids.size() == 1 && selected_node_ < 0 ? issue.arc_ids[0] : -1;
+      ++interaction_version_;
+    }
+    ImGui::PopStyleColor();
+    if (ImGui::IsItemHovered()) {
+      ImGui::BeginTooltip();
+      ImGui::Text("[%s] %s", issue.code.c_str(), issue.message.c_str());
+      ImGui::TextDisabled("click to focus the camera on it");
+      ImGui::EndTooltip();
+    }
+    ImGui::PopID();
+  }
+  ImGui::EndChild();
+}
+
+void App::draw_pipeline_section() {
+  if (!ImGui::CollapsingHeader("Pipeline", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  const bool has_mesh = doc_.mesh != nullptr;
+  if (!has_mesh) ImGui::BeginDisabled();
+  if (ImGui::Button("Run")) worker_->send(cmd::Run{});
+  ImGui::SameLine();
+  if (ImGui::Button("Pause")) worker_->send(cmd::Pause{});
+  ImGui::SameLine();
+  if (ImGui::Button("Step")) worker_->send(cmd::Step{});
+  ImGui::SameLine();
+  if (ImGui::Button("Stop")) worker_->send(cmd::Stop{});
+  if (!has_mesh) ImGui::EndDisabled();
+  if (!snapshot_) return;
+  const Snapshot& s = *snapshot_;
+  const ImVec4 color = s.status == WorkerStatus::Failed ? kErrorColor
+                       : s.status == WorkerStatus::Finished ? kOkColor
+                                                            : kDimColor;
+  ImGui::TextColored(color, "%s", to_string(s.status));
+  if (s.iteration > 0) {
+    ImGui::SameLine();
+    ImGui::Text("step %d", s.iteration);
+    if (std::isfinite(s.energy)) {
+      ImGui::SameLine();
+      ImGui::Text("E = %.6g", s.energy);
+    }
+  }
+  if (!s.message.empty()) ImGui::TextWrapped("%s", s.message.c_str());
+  std::vector<float> energies;
+  for (double e : s.energy_history)
+    if (std::isfinite(e)) energies.push_back(float(e));
+  if (energies.size() >= 2)
+    ImGui::PlotLines("##energy", energies.data(), int(energies.size()), 0, "energy", FLT_MAX,
+                     FLT_MAX, ImVec2(-1, 3.0f * ImGui::GetFontSize()));
+}
+
+void App::draw_view_section() {
+  if (!ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  if (ImGui::Button("Reset view (R)")) reset_view();
+  ImGui::SameLine();
+  if (ImGui::Button("Focus (F)")) focus_selection();
+  ImGui::PushID("mesh_layer");
+  mesh_layer_->ui();
+  ImGui::PopID();
+  ImGui::Separator();
+  ImGui::PushID("layout_layer");
+  layout_layer_->ui();
+  ImGui::PopID();
+  draw_legend();
+#ifndef NDEBUG
+  if (ImGui::Button("Reload shaders")) {
+    shader_log_.clear();
+    mesh_layer_->reload(&shader_log_);
+    layout_layer_->reload(&shader_log_);
+  }
+  if (!shader_log_.empty()) ImGui::TextColored(kErrorColor, "%s", shader_log_.c_str());
+  ImGui::SameLine();
+  ImGui::Checkbox("ImGui demo", &show_demo_);
+#endif
+}
+
+void App::draw_legend() {
+  ImGui::TextDisabled("Nodes by valence");
+  const struct {
+    int valence;
+    const char* label;
+  } nodes[] = {{4, "4"}, {3, "3"}, {5, "5"}, {6, "other"}};
+  for (const auto& n : nodes) {
+    color_swatch(n.label, render::LayoutColors::valence(n.valence));
+    ImGui::SameLine();
+    ImGui::TextUnformatted(n.label);
+    ImGui::SameLine();
+  }
+  ImGui::NewLine();
+  ImGui::TextDisabled("Arcs by label");
+  const struct {
+    const char* label;
+    const char* name;
+  } arcs[] = {{"u", "u"}, {"v", "v"}, {"", "unknown"}};
+  for (const auto& a : arcs) {
+    color_swatch(a.name, render::LayoutColors::label(a.label));
+    ImGui::SameLine();
+    ImGui::TextUnformatted(a.name);
+    ImGui::SameLine();
+  }
+  color_swatch("pinned", render::LayoutColors::kPin);
+  ImGui::SameLine();
+  ImGui::TextUnformatted("pinned");
+  ImGui::SameLine();
+  color_swatch("problem", render::LayoutColors::kProblem);
+  ImGui::SameLine();
+  ImGui::TextUnformatted("problem");
+}
+
+void App::draw_error_panel() {
+  if (errors_.empty()) return;
+  const ImGuiIO& io = ImGui::GetIO();
+  const float width = std::min(36.0f * ImGui::GetFontSize(), io.DisplaySize.x - 40.0f);
+  ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x * 0.5f + 6.0f * ImGui::GetFontSize(), 12.0f),
+                          ImGuiCond_Always, ImVec2(0.5f, 0.0f));
+  ImGui::SetNextWindowSize(ImVec2(width, 0.0f), ImGuiCond_Always);
+  ImGui::PushStyleColor(ImGuiCol_WindowBg, ImVec4(0.22f, 0.08f, 0.08f, 0.95f));
+  ImGui::Begin("Problems", nullptr,
+               ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoMove |
+                   ImGuiWindowFlags_NoSavedSettings);
+  ImGui::PushTextWrapPos(0.0f);
+  for (const auto& e : errors_) {
+    ImGui::TextColored(kErrorColor, "%s", e.c_str());
+    ImGui::Separator();
+  }
+  ImGui::PopTextWrapPos();
+  if (ImGui::Button("Dismiss")) errors_.clear();
+  ImGui::End();
+  ImGui::PopStyleColor();
+}
+
+void App::draw_autosave_prompt() {
+  if (!autosave_offer_) return;
+  const ImGuiIO& io = ImGui::GetIO();
+  ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x * 0.5f, io.DisplaySize.y * 0.4f), ImGuiCond_Always,
+                          ImVec2(0.5f, 0.5f));
+  ImGui::Begin("Restore autosave?", nullptr,
+               ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoCollapse |
+                   ImGuiWindowFlags_NoSavedSettings);
+  ImGui::Text("An autosaved layout from %s is newer than the opened file.",
+              autosave_offer_->saved_at.c_str());
+  ImGui::TextDisabled("%s", autosave_offer_->path.string().c_str());
+  if (ImGui::Button("Restore")) {
+    try {
+      Layout layout = load_layout(autosave_offer_->path.string(), *doc_.mesh);
+      doc_.editor.reset(doc_.mesh.get(), std::move(layout));
+      if (!autosave_offer_->layout_path.empty()) doc_.layout_path = autosave_offer_->layout_path;
+      save_field_ = doc_.layout_path;
+      doc_.dirty = true;
+      after_layout_replaced();
+      status_ = "Restored the autosave (not yet saved to the layout file)";
+    } catch (const std::exception& e) {
+      report_error(std::string("Cannot restore the autosave: ") + e.what());
+    }
+    autosave_offer_.reset();
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("Discard")) autosave_offer_.reset();
+  ImGui::End();
+}
+
+void App::draw_status_bar() {
+  const ImGuiIO& io = ImGui::GetIO();
+  const float height = ImGui::GetFrameHeightWithSpacing() + 4.0f;
+  ImGui::SetNextWindowPos(ImVec2(0.0f, io.DisplaySize.y - height));
+  ImGui::SetNextWindowSize(ImVec2(io.DisplaySize.x, height));
+  ImGui::PushStyleVar(ImGuiStyleVar_WindowRounding, 0.0f);
+  ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(10.0f, 4.0f));
+  ImGui::Begin("##status", nullptr,
+               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove |
+                   ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
+                   ImGuiWindowFlags_NoBringToFrontOnFocus);
+  ImGui::TextColored(kDimColor, "[%s]", tool_name(tool_));
+  ImGui::SameLine();
+  ImGui::TextUnformatted(status_.empty() ? tool_hint(tool_) : status_.c_str());
+  const std::string right = std::string(doc_.dirty ? "modified  " : "") +
+                            std::to_string(int(std::lround(io.Framerate))) + " fps";
+  ImGui::SameLine(io.DisplaySize.x - ImGui::CalcTextSize(right.c_str()).x - 14.0f);
+  ImGui::TextColored(kDimColor, "%s", right.c_str());
+  ImGui::End();
+  ImGui::PopStyleVar(2);
+}
+
+}  // namespace qs::app

@@ -1,0 +1,34 @@
+// Recently opened files, kept in ~/.config/quadsketch/recent.json (absence is fine).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace qs::app {
+
+class RecentFiles {
+ public:
+  //! $XDG_CONFIG_HOME/quadsketch/recent.json or ~/.config/quadsketch/recent.json.
+  static std::filesystem::path default_path();
+
+  //! Reads the list; a missing or corrupt file gives empty lists. Never throws.
+  void load(const std::filesystem::path& path = default_path());
+  //! Writes the list atomically; returns false (and keeps going) when it cannot.
+  bool save() const;
+
+  void add_mesh(const std::string& path);
+  void add_layout(const std::string& path);
+  const std::vector<std::string>& meshes() const { return meshes_; }
+  const std::vector<std::string>& layouts() const { return layouts_; }
+
+  std::size_t max_entries = 10;
+
+ private:
+  void add(std::vector<std::string>& list, const std::string& path);
+  std::filesystem::path path_;
+  std::vector<std::string> meshes_;
+  std::vector<std::string> layouts_;
+};
+
+}  // namespace qs::app

@@ -1,0 +1,33 @@
+#include "app/gui/screenshot.h"
+
+#ifndef GL_GLEXT_PROTOTYPES
+#define GL_GLEXT_PROTOTYPES
+#endif
+#include <GL/glcorearb.h>
+#include <stb_image_write.h>  // implementation lives in Debian's libstb
+
+#include <vector>
+
+namespace qs::app {
+
+bool save_framebuffer_png(const std::string& path, int width, int height, std::string* error) {
+  if (width <= 0 || height <= 0) {
+    if (error) *error = "empty framebuffer";
+    return false;
+  }
+  std::vector<unsigned char> pixels(static_cast<std::size_t>(width) * height * 3);
+  glReadBuffer(GL_BACK);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, width, height, GL_RGB, GL_UNSIGNED_BYTE, pixels.data());
+  // GL rows start at the bottom; PNG rows at the top.
+  stbi_flip_vertically_on_write(1);
+  const int ok = stbi_write_png(path.c_str(), width, height, 3, pixels.data(), width * 3);
+  stbi_flip_vertically_on_write(0);
+  if (!ok) {
+    if (error) *error = "cannot write " + path;
+    return false;
+  }
+  return true;
+}
+
+}  // namespace qs::app

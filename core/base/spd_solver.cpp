@@ -1,0 +1,91 @@
+#include "core/base/spd_solver.h"
+
+#include <Eigen/CholmodSupport>
+#include <chrono>
+
+#include "core/base/errors.h"
+
+namespace qs {
+
+namespace {
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+struct SpdSolver::Impl {
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+  Eigen::Index rows = -1;
+  Eigen::Index nnz = -1;
+  bool analyzed = false;
+  bool factorized = false;
+};
+
+SpdSolver::SpdSolver(std::string stage)
+    : impl_(std::make_unique<Impl>()), stage_(std::move(stage)) {}
+SpdSolver::~SpdSolver() = default;
+SpdSolver::SpdSolver(SpdSolver&&) noexcept = default;
+SpdSolver& SpdSolver::operator=(SpdSolver&&) noexcept = default;
+
+void SpdSolver::analyze(const Eigen::SparseMatrix<double>& A) {
+  if (A.rows() != A.cols()) throw SolverError(stage_ + ": matrix is not square");
+  const auto t0 = std::chrono::steady_clock::now();
+  impl_->llt.analyzePattern(A);
+  if (impl_->llt.info() != Eigen::Success)
+    throw SolverError(stage_ + ": symbolic analysis failed (" + std::to_string(A.rows()) +
+                      " unknowns)");
+  impl_->rows = A.rows();
+  impl_->nnz = A.nonZeros();
+  impl_->analyzed = true;
+  impl_->factorized = false;
+  stats_.analyze_s = seconds_since(t0);
+  ++stats_.analyses;
+}
+
+void SpdSolver::factorize(const Eigen::SparseMatrix<double>& A) {
+  if (!impl_->analyzed || A.rows() != impl_->rows || A.nonZeros() != impl_->nnz) analyze(A);
+  for (Eigen::Index k = 0; k < A.nonZeros(); ++k) {
+    if (!std::isfinite(A.valuePtr()[k]))
+      throw SolverError(stage_ + ": matrix has non-finite entries (" + std::to_string(A.rows()) +
+                        " unknowns)");
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  impl_->llt.factorize(A);
+  impl_->factorized = impl_->llt.info() == Eigen::Success;
+  if (!impl_->factorized)
+    throw SolverError(stage_ + ": matrix is not positive definite (" + std::to_string(A.rows()) +
+                      " unknowns)");
+  stats_.factorize_s = seconds_since(t0);
+  ++stats_.factorizations;
+}
+
+Eigen::VectorXd SpdSolver::solve(const Eigen::VectorXd& b) {
+  if (!impl_->factorized) throw SolverError(stage_ + ": solve called before a factorization");
+  if (!b.allFinite()) throw SolverError(stage_ + ": right-hand side has non-finite entries");
+  const auto t0 = std::chrono::steady_clock::now();
+  Eigen::VectorXd x = impl_->llt.solve(b);
+  stats_.solve_s = seconds_since(t0);
+  ++stats_.solves;
+  if (impl_->llt.info() != Eigen::Success || !x.allFinite())
+    throw SolverError(stage_ + ": solve produced non-finite values (" + std::to_string(b.size()) +
+                      " unknowns)");
+  return x;
+}
+
+Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& B) {
+  if (!impl_->factorized) throw SolverError(stage_ + ": solve called before a factorization");
+  if (!B.allFinite()) throw SolverError(stage_ + ": right-hand side has non-finite entries");
+  const auto t0 = std::chrono::steady_clock::now();
+  Eigen::MatrixXd X = impl_->llt.solve(B);
+  stats_.solve_s = seconds_since(t0);
+  ++stats_.solves;
+  if (impl_->llt.info() != Eigen::Success || !X.allFinite())
+    throw SolverError(stage_ + ": solve produced non-finite values");
+  return X;
+}
+
+bool SpdSolver::factorized() const {
+  return impl_->factorized;
+}
+
+}  // namespace qs

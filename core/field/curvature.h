@@ -1,0 +1,68 @@
+// Principal curvature directions per face (normal-cycle tensor) and the direction constraints
+// that guide the cross field: reliable curvature regions, sharp features and boundaries
+// (paper §4.2, algorithm.md §2).
+#pragma once
+
+#include <vector>
+
+#include "core/layout/layout.h"
+#include "core/mesh/geometry.h"
+#include "core/mesh/mesh.h"
+
+namespace qs {
+
+struct CurvatureOptions {
+  //! Neighbourhood of the per-face tensor: vertices within this many edge rings of the face.
+  int rings = 2;
+  //! A face is reliable when |κ1 − κ2| ≥ min_anisotropy · s95, where s95 is the 95th
+  //! percentile of max(|κ1|, |κ2|) over all faces (normalised anisotropy, as QuadWild's 0.4)…
+  double min_anisotropy = 0.4;
+  //! …and |κ1 − κ2| ≥ min_ratio · (|κ1| + |κ2|) (clearly anisotropic, not umbilic).
+  double min_ratio = 0.5;
+  //! Reliable regions with fewer faces than this are dropped as noise.
+  int min_region_faces = 8;
+};
+
+//! Per-face principal curvatures (1/length units) and directions (unit, in the face plane).
+struct Curvature {
+  std::vector<double> k_max, k_min;  //!< signed, k_max ≥ k_min; size #F
+  std::vector<Vec3> dir_max;         //!< direction of k_max; dir_min = n × dir_max; size #F
+  std::vector<char> reliable;        //!< size #F
+  int reliable_faces = 0;
+};
+
+//! Normal-cycle curvature tensor (Cohen-Steiner & Morvan) per face over a ring neighbourhood.
+Curvature compute_curvature(const TriMesh& mesh, const GeometryCache& geometry,
+                            const CurvatureOptions& options = {});
+
+//! Edges whose dihedral angle (between face normals) exceeds \p sharp_angle_deg, plus the
+//! layout's feature edges. Boundary edges are not included. Size #E flags.
+std::vector<char> sharp_edges(const TriMesh& mesh, const GeometryCache& geometry,
+                              double sharp_angle_deg, const Layout* layout = nullptr);
+
+enum class ConstraintKind : char { Curvature = 0, Feature = 1, Boundary = 2 };
+
+//! Direction constraints on faces: the field's first direction should be (mod 90°) `direction`.
+struct FieldConstraints {
+  std::vector<int> face;
+  std::vector<Vec3> direction;  //!< unit, in the face plane (original geometry)
+  std::vector<ConstraintKind> kind;
+  int count(ConstraintKind k) const;
+};
+
+struct ConstraintOptions {
+  bool curvature = true;  //!< false for the alignment-oblivious baseline (--no-align)
+  bool features = true;
+  bool boundary = true;
+  double sharp_angle_deg = 35.0;
+  CurvatureOptions curvature_options;
+};
+
+//! Collects constraints: faces with a boundary edge follow it, faces with a sharp/feature edge
+//! follow that edge (boundary and feature constraints override curvature), reliable faces follow
+//! their principal directions.
+FieldConstraints collect_constraints(const TriMesh& mesh, const GeometryCache& geometry,
+                                     const Layout* layout, const ConstraintOptions& options,
+                                     const Curvature* curvature = nullptr);
+
+}  // namespace qs

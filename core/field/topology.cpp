@@ -1,0 +1,452 @@
+#include "core/field/topology.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <map>
+#include <sstream>
+
+#include "core/base/errors.h"
+#include "core/mesh/mesh_checks.h"
+
+namespace qs {
+
+namespace {
+
+// Sign of the ccw step around v across edge e = {v, b}: +1 iff it runs along the dual edge's
+// canonical orientation, i.e. iff b < v (algorithm.md §1.3).
+int ccw_sign(const GeometryCache& g, int e, int v) {
+  const auto [a, b] = g.edge_vertices[e];
+  const int other = (a == v) ? b : a;
+  return other < v ? +1 : -1;
+}
+
+bool interior_edge(const GeometryCache& g, int e) {
+  return g.edge_face_i[e] >= 0 && g.edge_face_j[e] >= 0;
+}
+
+// 4·I_0(v) = 4·round((Ω − Σ_ccw κ)/2π) for interior vertices.
+std::vector<int> base_quarter_indices(const TriMesh& mesh, const GeometryCache& g) {
+  std::vector<double> sum(g.n_vertices, 0.0);
+  for (int e = 0; e < g.n_edges; ++e) {
+    if (!interior_edge(g, e)) continue;
+    const auto [a, b] = g.edge_vertices[e];
+    sum[a] += ccw_sign(g, e, a) * g.kappa[e];
+    sum[b] += ccw_sign(g, e, b) * g.kappa[e];
+  }
+  std::vector<int> i0(g.n_vertices, 0);
+  for (auto v : mesh.vertices()) {
+    if (g.vertex_on_boundary[v.idx()]) continue;
+    i0[v.idx()] =
+        4 * static_cast<int>(std::lround((g.angle_defect[v.idx()] - sum[v.idx()]) / (2 * M_PI)));
+  }
+  return i0;
+}
+
+std::string arc_list(const Layout& layout, const std::vector<std::pair<int, bool>>& cycle) {
+  std::ostringstream ss;
+  for (size_t i = 0; i < cycle.size(); ++i) ss << (i ? ", " : "") << layout.arcs[cycle[i].first].id;
+  return ss.str();
+}
+
+// Affine integer function c + Σ coef_k g_k.
+struct Affine {
+  long c = 0;
+  std::vector<long> coef;
+};
+
+}  // namespace
+
+std::vector<int> target_quarter_indices(const TriMesh& mesh, const Layout& layout,
+                                        const LayoutTopology& topology) {
+  std::vector<int> t(mesh.n_vertices(), 0);
+  for (int n = 0; n < topology.num_nodes; ++n) {
+    const int v = layout.nodes[n].vertex;
+    if (!mesh.is_boundary(mesh.vertex_handle(v))) t[v] = 4 - topology.valence[n];
+  }
+  return t;
+}
+
+std::vector<int> quarter_indices_from_jumps(const GeometryCache& g, const std::vector<int>& p) {
+  std::vector<double> sum(g.n_vertices, 0.0);
+  std::vector<long> psum(g.n_vertices, 0);
+  for (int e = 0; e < g.n_edges; ++e) {
+    if (!interior_edge(g, e)) continue;
+    for (int v : g.edge_vertices[e]) {
+      sum[v] += ccw_sign(g, e, v) * g.kappa[e];
+      psum[v] += ccw_sign(g, e, v) * p[e];
+    }
+  }
+  std::vector<int> idx(g.n_vertices, 0);
+  for (int v = 0; v < g.n_vertices; ++v) {
+    if (g.vertex_on_boundary[v]) continue;
+    const long i0 = 4 * std::lround((g.angle_defect[v] - sum[v]) / (2 * M_PI));
+    idx[v] = static_cast<int>(i0 - psum[v]);
+  }
+  return idx;
+}
+
+std::vector<std::vector<std::pair<int, bool>>> layout_fundamental_cycles(
+    const Layout& layout, const LayoutTopology& topo) {
+  const int n = topo.num_nodes;
+  std::vector<std::vector<std::pair<int, int>>> adj(n);  // (arc, neighbour)
+  for (int a = 0; a < topo.num_arcs; ++a) {
+    if (layout.arcs[a].dangling()) continue;
+    const int u = topo.half_node[2 * a], v = topo.half_node[2 * a + 1];
+    adj[u].push_back({a, v});
+    if (u != v) adj[v].push_back({a, u});
+  }
+  std::vector<int> parent_arc(n, -1), depth(n, -1), parent(n, -1);
+  std::vector<char> tree_arc(topo.num_arcs, 0);
+  for (int root = 0; root < n; ++root) {
+    if (depth[root] >= 0) continue;
+    depth[root] = 0;
+    std::deque<int> queue{root};
+    while (!queue.empty()) {
+      const int u = queue.front();
+      queue.pop_front();
+      for (auto [a, v] : adj[u]) {
+        if (depth[v] >= 0) continue;
+        depth[v] = depth[u] + 1;
+        parent[v] = u;
+        parent_arc[v] = a;
+        tree_arc[a] = 1;
+        queue.push_back(v);
+      }
+    }
+  }
+  std::vector<std::vector<std::pair<int, bool>>> cycles;
+  for (int a = 0; a < topo.num_arcs; ++a) {
+    if (tree_arc[a] || layout.arcs[a].dangling()) continue;
+    const int u = topo.half_node[2 * a], v = topo.half_node[2 * a + 1];
+    // Cycle: u → v along a, then v up to the common ancestor, then down to u.
+    std::vector<std::pair<int, bool>> up_from_v, up_from_u;
+    int x = v, y = u;
+    while (depth[x] > depth[y])
+      up_from_v.push_back({parent_arc[x], topo.half_node[2 * parent_arc[x]] == x}), x = parent[x];
+    while (depth[y] > depth[x])
+      up_from_u.push_back({parent_arc[y], topo.half_node[2 * parent_arc[y]] == y}), y = parent[y];
+    while (x != y) {
+      up_from_v.push_back({parent_arc[x], topo.half_node[2 * parent_arc[x]] == x});
+      x = parent[x];
+      up_from_u.push_back({parent_arc[y], topo.half_node[2 * parent_arc[y]] == y});
+      y = parent[y];
+    }
+    std::vector<std::pair<int, bool>> cycle{{a, true}};
+    cycle.insert(cycle.end(), up_from_v.begin(), up_from_v.end());
+    for (auto it = up_from_u.rbegin(); it != up_from_u.rend(); ++it)
+      cycle.push_back({it->first, !it->second});
+    cycles.push_back(std::move(cycle));
+  }
+  return cycles;
+}
+
+namespace {
+
+// One layout cycle turned into an equation Σ_Γ sign·p_e = rhs (algorithm.md §1.3).
+struct CycleEquation {
+  std::vector<std::pair<int, int>> terms;  // (edge, sign)
+  long rhs = 0;
+  bool ok = false;
+};
+
+CycleEquation cycle_equation(const TriMesh& mesh, const GeometryCache& g, const Layout& layout,
+                             const LayoutTopology& topo,
+                             const std::vector<std::pair<int, bool>>& cycle) {
+  CycleEquation eq;
+  // Closed vertex path and the half-arcs at each node.
+  std::vector<int> path;
+  long sectors_term = 0;  // Σ (2 − s_i)
+  const int m = static_cast<int>(cycle.size());
+  for (int i = 0; i < m; ++i) {
+    const auto [a, fwd] = cycle[i];
+    const auto& p = layout.arcs[a].path;
+    if (fwd)
+      path.insert(path.end(), p.begin(), p.end() - 1);
+    else
+      path.insert(path.end(), p.rbegin(), p.rend() - 1);
+    // Node at the start of this arc: h_out leaves along it, h_in is the previous arc's end.
+    const int h_out = fwd ? 2 * a : 2 * a + 1;
+    const auto [pa, pfwd] = cycle[(i + m - 1) % m];
+    const int h_in = pfwd ? 2 * pa + 1 : 2 * pa;
+    const int node = topo.half_node[h_out];
+    const auto& list = topo.node_half_arcs[node];
+    const int val = static_cast<int>(list.size());
+    const int pos_out = static_cast<int>(std::find(list.begin(), list.end(), h_out) - list.begin());
+    const int pos_in = static_cast<int>(std::find(list.begin(), list.end(), h_in) - list.begin());
+    const int s = ((pos_in - pos_out) % val + val) % val;
+    sectors_term += 2 - s;
+  }
+  const int len = static_cast<int>(path.size());
+  double kappa_sum = 0, angle_term = 0;
+  for (int k = 0; k < len; ++k) {
+    const auto u = mesh.vertex_handle(path[(k + len - 1) % len]);
+    const auto w = mesh.vertex_handle(path[k]);
+    const auto y = mesh.vertex_handle(path[(k + 1) % len]);
+    const auto h_in = mesh.find_halfedge(u, w);
+    const auto h_out = mesh.find_halfedge(w, y);
+    if (mesh.is_boundary(h_in) || mesh.is_boundary(h_out)) return eq;  // exterior on the left
+    auto corner = [&](OpenMesh::HalfedgeHandle out) {
+      const int f = mesh.face_handle(out).idx();
+      const auto& fv = g.face_vertices[f];
+      const int c = fv[0] == w.idx() ? 0 : (fv[1] == w.idx() ? 1 : 2);
+      return g.corner_angle[3 * f + c];
+    };
+    auto h = mesh.next_halfedge_handle(h_in);  // w→x in face(u→w)
+    double beta = corner(h);
+    int guard = 0;
+    while (h != h_out) {
+      const int e = mesh.edge_handle(h).idx();
+      const int z = mesh.to_vertex_handle(h).idx();
+      const int sign = w.idx() < z ? +1 : -1;
+      const auto opp = mesh.opposite_halfedge_handle(h);
+      if (mesh.is_boundary(opp)) return eq;  // the left side runs through the exterior
+      eq.terms.push_back({e, sign});
+      kappa_sum += sign * g.kappa[e];
+      h = mesh.next_halfedge_handle(opp);
+      beta += corner(h);
+      if (++guard > 10000) return eq;
+    }
+    angle_term += M_PI - beta;
+  }
+  const double W = (kappa_sum + angle_term) / (2 * M_PI);
+  const long Wi = std::lround(W);
+  if (std::abs(W - Wi) > 1e-6) {
+    throw QsError("internal error: non-integral winding " + std::to_string(W) +
+                  " along layout cycle (arcs " + arc_list(layout, cycle) + ")");
+  }
+  eq.rhs = sectors_term - 4 * Wi;
+  eq.ok = true;
+  return eq;
+}
+
+}  // namespace
+
+std::vector<int> compute_period_jumps(const TriMesh& mesh, const GeometryCache& g,
+                                      const Layout& layout, const LayoutTopology& topo,
+                                      PeriodJumpReport* report) {
+  const int nv = g.n_vertices, nf = g.n_faces, ne = g.n_edges;
+  PeriodJumpReport rep;
+  // c_v = 4 I_0(v) − 4 I_target(v).
+  const std::vector<int> i0 = base_quarter_indices(mesh, g);
+  const std::vector<int> target = target_quarter_indices(mesh, layout, topo);
+
+  // 1. Dual spanning tree T* (BFS over faces); p = 0 on it.
+  std::vector<char> in_tstar(ne, 0);
+  {
+    std::vector<char> seen(nf, 0);
+    for (int root = 0; root < nf; ++root) {
+      if (seen[root]) continue;
+      seen[root] = 1;
+      std::deque<int> queue{root};
+      while (!queue.empty()) {
+        const int f = queue.front();
+        queue.pop_front();
+        for (auto h : mesh.fh_range(mesh.face_handle(f))) {
+          const auto opp = mesh.opposite_halfedge_handle(h);
+          if (mesh.is_boundary(opp)) continue;
+          const int f2 = mesh.face_handle(opp).idx();
+          if (seen[f2]) continue;
+          seen[f2] = 1;
+          in_tstar[mesh.edge_handle(h).idx()] = 1;
+          queue.push_back(f2);
+        }
+      }
+    }
+  }
+
+  // 2. Primal graph: interior vertices and one virtual vertex per boundary loop.
+  const auto loops = boundary_loops(mesh);
+  const int nb = static_cast<int>(loops.size());
+  std::vector<int> gnode(nv);
+  for (int v = 0; v < nv; ++v) gnode[v] = v;
+  for (int l = 0; l < nb; ++l)
+    for (int v : loops[l]) gnode[v] = nv + l;
+  const int ng = nv + nb;
+  std::vector<std::vector<int>> incident(ng);  // eligible edges per graph node
+  std::vector<char> is_free(ne, 0);
+  for (int e = 0; e < ne; ++e) {
+    if (!interior_edge(g, e) || in_tstar[e]) continue;
+    const int a = gnode[g.edge_vertices[e][0]], b = gnode[g.edge_vertices[e][1]];
+    if (a == b) {
+      is_free[e] = 1;  // a chord of one boundary loop that does not separate: generator-like
+      continue;
+    }
+    incident[a].push_back(e);
+    incident[b].push_back(e);
+  }
+  // Spanning tree T (BFS) from the root: the first boundary loop, or vertex 0 when closed.
+  const int root = nb > 0 ? nv : 0;
+  std::vector<int> parent_edge(ng, -1), order;
+  std::vector<char> reached(ng, 0);
+  std::vector<char> in_t(ne, 0);
+  {
+    reached[root] = 1;
+    std::deque<int> queue{root};
+    while (!queue.empty()) {
+      const int x = queue.front();
+      queue.pop_front();
+      order.push_back(x);
+      for (int e : incident[x]) {
+        const int a = gnode[g.edge_vertices[e][0]], b = gnode[g.edge_vertices[e][1]];
+        const int y = a == x ? b : a;
+        if (reached[y]) continue;
+        reached[y] = 1;
+        parent_edge[y] = e;
+        in_t[e] = 1;
+        queue.push_back(y);
+      }
+    }
+  }
+  for (int x = 0; x < ng; ++x) {
+    const bool used = x >= nv || !g.vertex_on_boundary[x];
+    if (used && !reached[x])
+      throw InvalidInputError("the mesh is not connected; the cross field needs one component");
+  }
+  // Free unknowns: leftover edges (2g generators, chords) and the parent edges of the non-root
+  // boundary loops, whose turning numbers come from layout cycles.
+  for (int e = 0; e < ne; ++e)
+    if (interior_edge(g, e) && !in_tstar[e] && !in_t[e]) is_free[e] = 1;
+  for (int l = 0; l < nb; ++l)
+    if (nv + l != root) is_free[parent_edge[nv + l]] = 1;
+  std::vector<int> free_index(ne, -1);
+  int nfree = 0;
+  for (int e = 0; e < ne; ++e)
+    if (is_free[e]) free_index[e] = nfree++;
+  rep.free_unknowns = nfree;
+
+  // 3. Solve the vertex equations leaves-first; p as affine functions of the free unknowns.
+  std::vector<Affine> p(ne);
+  for (int e = 0; e < ne; ++e) {
+    p[e].coef.assign(nfree, 0);
+    if (is_free[e]) p[e].coef[free_index[e]] = 1;
+  }
+  // All interior edges around each interior vertex.
+  std::vector<std::vector<int>> around(nv);
+  for (int e = 0; e < ne; ++e) {
+    if (!interior_edge(g, e)) continue;
+    around[g.edge_vertices[e][0]].push_back(e);
+    around[g.edge_vertices[e][1]].push_back(e);
+  }
+  auto residual = [&](int v) {  // c_v − Σ_ccw p, as affine
+    Affine r;
+    r.c = i0[v] - target[v];
+    r.coef.assign(nfree, 0);
+    for (int e : around[v]) {
+      const int s = ccw_sign(g, e, v);
+      r.c -= s * p[e].c;
+      for (int k = 0; k < nfree; ++k) r.coef[k] -= s * p[e].coef[k];
+    }
+    return r;
+  };
+  for (auto it = order.rbegin(); it != order.rend(); ++it) {
+    const int x = *it;
+    if (x == root || x >= nv) continue;  // boundary loops: handled through free unknowns
+    const int e = parent_edge[x];
+    // p_e currently 0; solve s·p_e = residual.
+    const Affine r = residual(x);
+    const int s = ccw_sign(g, e, x);
+    p[e].c = s * r.c;
+    for (int k = 0; k < nfree; ++k) p[e].coef[k] = s * r.coef[k];
+  }
+  if (nb == 0) {
+    const Affine r = residual(root);
+    bool zero = r.c == 0;
+    for (long c : r.coef) zero = zero && c == 0;
+    if (!zero) {
+      long total = 0;
+      for (int v = 0; v < nv; ++v) total += target[v];
+      throw TopologyError("the layout's node valences give singularity indices that sum to " +
+                          std::to_string(total) + "/4, but the surface needs " +
+                          std::to_string(4 * (nv - ne + nf)) + "/4 (Poincaré–Hopf)");
+    }
+  }
+
+  // 4. Fix the free unknowns with layout cycle equations.
+  std::vector<long> gval(nfree, 0);
+  const auto cycles = layout_fundamental_cycles(layout, topo);
+  std::vector<std::vector<long>> rows;
+  std::vector<long> rhs;
+  std::vector<int> row_cycle;
+  for (size_t c = 0; c < cycles.size(); ++c) {
+    CycleEquation eq = cycle_equation(mesh, g, layout, topo, cycles[c]);
+    if (!eq.ok) {
+      auto reversed = cycles[c];
+      std::reverse(reversed.begin(), reversed.end());
+      for (auto& [a, fwd] : reversed) fwd = !fwd;
+      eq = cycle_equation(mesh, g, layout, topo, reversed);
+    }
+    if (!eq.ok) {
+      ++rep.cycles_skipped;
+      continue;
+    }
+    std::vector<long> row(nfree, 0);
+    long b = eq.rhs;
+    for (auto [e, s] : eq.terms) {
+      b -= s * p[e].c;
+      for (int k = 0; k < nfree; ++k) row[k] += s * p[e].coef[k];
+    }
+    rows.push_back(std::move(row));
+    rhs.push_back(b);
+    row_cycle.push_back(static_cast<int>(c));
+  }
+  rep.cycles = static_cast<int>(rows.size());
+  if (nfree > 0) {
+    Eigen::MatrixXd A(rows.size(), nfree);
+    Eigen::VectorXd B(rows.size());
+    for (size_t r = 0; r < rows.size(); ++r) {
+      for (int k = 0; k < nfree; ++k) A(r, k) = static_cast<double>(rows[r][k]);
+      B(r) = static_cast<double>(rhs[r]);
+    }
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
+    qr.setThreshold(1e-9);
+    rep.rank = rows.empty() ? 0 : static_cast<int>(qr.rank());
+    if (rep.rank < nfree) {
+      std::ostringstream ss;
+      ss << "the layout does not determine the cross-field turning number of " << (nfree - rep.rank)
+         << " homology generator or boundary cycle(s); every handle and every boundary loop must "
+            "be "
+            "crossed or followed by a closed cycle of arcs";
+      throw TopologyError(ss.str());
+    }
+    const Eigen::VectorXd sol = qr.solve(B);
+    for (int k = 0; k < nfree; ++k) {
+      if (std::abs(sol(k) - std::round(sol(k))) > 1e-6) {
+        throw TopologyError("the layout implies a non-integral cross-field turning number (" +
+                            std::to_string(sol(k)) + " quarter turns) along a homology generator");
+      }
+      gval[k] = std::lround(sol(k));
+    }
+  }
+  for (size_t r = 0; r < rows.size(); ++r) {
+    long lhs = 0;
+    for (int k = 0; k < nfree; ++k) lhs += rows[r][k] * gval[k];
+    if (lhs != rhs[r]) {
+      throw TopologyError(
+          "the layout cycle through arcs " + arc_list(layout, cycles[row_cycle[r]]) +
+          " needs a cross-field turning of " + std::to_string(rhs[r] - lhs) +
+          " quarter turns that no field with singularities only at the nodes can have");
+    }
+  }
+
+  std::vector<int> out(ne, 0);
+  for (int e = 0; e < ne; ++e) {
+    long val = p[e].c;
+    for (int k = 0; k < nfree; ++k) val += p[e].coef[k] * gval[k];
+    out[e] = static_cast<int>(val);
+    rep.max_abs_jump = std::max(rep.max_abs_jump, std::abs(out[e]));
+  }
+  // Every interior vertex must now have its target index.
+  const std::vector<int> idx = quarter_indices_from_jumps(g, out);
+  for (int v = 0; v < nv; ++v) {
+    if (!g.vertex_on_boundary[v] && idx[v] != target[v])
+      throw QsError("internal error: vertex " + std::to_string(v) + " has index " +
+                    std::to_string(idx[v]) + "/4 instead of " + std::to_string(target[v]) +
+                    "/4 after period-jump construction");
+  }
+  if (report) *report = rep;
+  return out;
+}
+
+}  // namespace qs

@@ -1,0 +1,39 @@
+// Layout validation: every problem is reported as data, with the ids involved.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/layout/layout.h"
+#include "core/mesh/mesh.h"
+
+namespace qs {
+
+enum class IssueSeverity { Error, Warning };
+
+struct LayoutIssue {
+  IssueSeverity severity = IssueSeverity::Error;
+  std::string code;     //!< stable machine-readable kind, e.g. "arc_crossing", "patch_valence"
+  std::string message;  //!< human-readable, names the ids
+  std::vector<int> node_ids;
+  std::vector<int> arc_ids;
+  std::vector<int> vertices;     //!< mesh vertices where the problem is (for highlighting)
+  std::vector<int> patch_faces;  //!< a face of the offending patch, if any
+};
+
+struct ValidationResult {
+  std::vector<LayoutIssue> issues;
+  bool valid() const;  //!< no Error issue
+  int errors() const;
+  int warnings() const;
+};
+
+//! Checks a layout against a mesh (interfaces.md §1, algorithm.md §1.2): ids, paths,
+//! disjointness, dangling ends, patch disks, patch valences, Euler characteristic,
+//! connectivity, high-valence warnings. Never throws for bad layouts.
+ValidationResult validate_layout(const TriMesh& mesh, const Layout& layout);
+
+//! One line per issue: "error [arc_crossing] arcs 3 and 7 share mesh edge (12, 13)".
+std::string format_issue(const LayoutIssue& issue);
+
+}  // namespace qs

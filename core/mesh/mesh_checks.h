@@ -1,0 +1,52 @@
+// Topological and geometric checks of meshes (used by load_mesh and by the pipeline).
+#pragma once
+
+#include <vector>
+
+#include "core/mesh/mesh.h"
+#include "core/mesh/mesh_io.h"
+
+namespace qs {
+
+//! Builds a triangle mesh from a soup, recording every problem in \p report (it never throws).
+//! All soup vertices are added first in order (vertex idx() == soup index, unreferenced ones
+//! included); faces follow in soup order, polygons expanding in place into a fan from the
+//! corner whose worst triangle has the largest smallest angle (or, with
+//! options.triangulate == false, being reported in non_triangle_faces).
+//! Checks, all from the soup or the built mesh, never silently repaired:
+//! - bad_index_faces: an index outside [0, #points).
+//! - degenerate_faces: a repeated vertex index (not added), or zero area, i.e.
+//!   area <= 1e-14 * (bounding-box diagonal of the finite points)^2 (still added). Slivers such
+//!   as block.off's (relative area ~1e-7) stay valid; collinear corners give ~1e-16 or 0.
+//! - nonfinite_vertices: NaN or infinite coordinates.
+//! - dropped_faces / drop_reasons: add_face refused the face (an edge that already has two
+//!   faces, an edge already used in the same direction, a complex vertex) or it repeats an
+//!   earlier face's vertex cycle in either direction.
+//! - nonmanifold_vertices: the soup faces around the vertex do not form one fan (their link
+//!   is not a single path or cycle), whether OpenMesh accepted them (two fans touching at a
+//!   vertex, seen by is_manifold()) or refused some; plus every vertex !is_manifold().
+//! - unreferenced_vertices: used by no soup face.
+//! Then count_topology() fills the counts.
+TriMesh build_tri_mesh(const PolygonSoup& soup, MeshReport& report, const LoadMeshOptions& options);
+
+//! Same for a polygon mesh (faces are kept as they are).
+PolyMesh build_poly_mesh(const PolygonSoup& soup, MeshReport& report);
+
+//! Fills the counts of \p report (vertices, faces, edges, components, boundary loops, Euler
+//! characteristic, genus) from \p mesh. Components are vertex-connected sets of faces; the
+//! Euler characteristic counts only vertices that belong to a face (isolated ones are reported
+//! as unreferenced instead); genus = (2 * components - boundary_loops - chi) / 2.
+//! Instantiated for TriMesh and PolyMesh.
+template <typename MeshT>
+void count_topology(const MeshT& mesh, MeshReport& report);
+
+//! Boundary loops as vertex index cycles, each ordered with the interior on the left
+//! (i.e. along the non-boundary halfedges of the boundary edges). Each loop starts at its
+//! smallest vertex index and the loops are sorted, so the result depends only on the mesh.
+std::vector<std::vector<int>> boundary_loops(const TriMesh& mesh);
+
+//! Connected component id per face (size #F) and the number of components. Faces sharing a
+//! vertex are connected; ids are numbered in order of each component's first face.
+std::vector<int> face_components(const TriMesh& mesh, int* count = nullptr);
+
+}  // namespace qs

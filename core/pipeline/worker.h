@@ -1,0 +1,161 @@
+// The pipeline worker: one thread that owns all algorithm state, driven by a command queue,
+// streaming immutable versioned snapshots (architecture.md, "Threading model"). No GL here.
+//
+// The UI thread only calls the public member functions below; they lock, enqueue and notify.
+// The worker thread drains the queue between steps (never during one), runs the pluggable
+// StepFunction without holding any lock, and publishes a new Snapshot under the lock.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <stop_token>
+#include <string>
+#include <thread>
+#include <variant>
+
+#include "core/layout/layout.h"
+#include "core/mesh/mesh.h"
+#include "core/pipeline/snapshot.h"
+
+namespace qs {
+
+//! Options of a job; changed with SetOptions, read by the step function at its next step.
+struct WorkerOptions {
+  int max_steps = 25;               //!< the job finishes after this many steps
+  double publish_interval_ms = 16;  //!< minimum time between intermediate snapshots
+  bool node_optimization = true;
+  double quad_size = 0.0;  //!< 0: automatic
+};
+
+//! What a step function sees of the job. Lives on the worker thread only.
+class WorkerObserver {
+ public:
+  WorkerObserver(const std::atomic<std::uint64_t>& generation, std::uint64_t job_generation,
+                 std::stop_token stop)
+      : generation_(generation), job_generation_(job_generation), stop_(std::move(stop)) {}
+  //! True when the job was superseded (LoadMesh, Stop) or the worker shuts down. Core code
+  //! checks it between solves and throws Cancelled.
+  bool should_cancel() const {
+    return stop_.stop_requested() || generation_.load(std::memory_order_acquire) != job_generation_;
+  }
+  //! Throws Cancelled when should_cancel().
+  void check_cancel() const;
+
+ private:
+  const std::atomic<std::uint64_t>& generation_;
+  std::uint64_t job_generation_;
+  std::stop_token stop_;
+};
+
+//! Mutable algorithm state, owned by the worker thread.
+struct WorkerState {
+  std::shared_ptr<const TriMesh> mesh;
+  Layout layout;              //!< the job's current layout
+  std::map<int, int> pins;    //!< node id -> target vertex (SetPin / ClearPin)
+  bool pins_changed = false;  //!< set when pins changed since the last step
+  WorkerOptions options;
+  int iteration = 0;  //!< steps done in this job (incremented by the worker)
+  //! Stage state of the plugged pipeline (field, factorization, ...); reset on LoadMesh/Stop.
+  std::shared_ptr<void> user;
+};
+
+//! Output of one step. Fields left empty keep the previous snapshot's value.
+struct StepResult {
+  bool finished = false;  //!< the job is complete; the worker goes to Finished
+  std::string message;
+  double energy = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::array<float, 2>> corner_uv;
+  std::vector<char> face_foldover;
+  bool validate = true;  //!< run validate_layout on the state's layout for the snapshot
+};
+
+//! One step of a job. Throws QsError on failure (-> status Failed), Cancelled when cancelled.
+using StepFunction = std::function<StepResult(WorkerState&, const WorkerObserver&)>;
+
+//! Commands (each carries the seq number given by Worker::send).
+namespace cmd {
+struct LoadMesh {
+  std::shared_ptr<const TriMesh> mesh;
+  Layout layout;
+};
+struct Run {};
+struct Pause {};
+struct Step {
+  int count = 1;
+};
+struct Stop {};
+struct SetPin {
+  int node_id = -1;
+  int vertex = -1;
+};
+struct ClearPin {
+  int node_id = -1;
+};
+struct SetOptions {
+  WorkerOptions options;
+};
+struct SetLayout {  //!< replace the layout (after an edit); cancels a running job
+  Layout layout;
+};
+struct Shutdown {};
+}  // namespace cmd
+
+using Command = std::variant<cmd::LoadMesh, cmd::Run, cmd::Pause, cmd::Step, cmd::Stop, cmd::SetPin,
+                             cmd::ClearPin, cmd::SetOptions, cmd::SetLayout, cmd::Shutdown>;
+
+class Worker {
+ public:
+  //! Starts the worker thread. \p step is run once per step of a job.
+  explicit Worker(StepFunction step);
+  //! Sends Shutdown, cancels the running step and joins.
+  ~Worker();
+  Worker(const Worker&) = delete;
+  Worker& operator=(const Worker&) = delete;
+
+  //! Enqueues a command and returns its seq number (1, 2, ...). Thread-safe.
+  //! Structural commands (LoadMesh, SetLayout, Stop, Shutdown) cancel the running step at once.
+  //! A SetPin replaces a still-queued SetPin for the same node (the latest one wins).
+  std::uint64_t send(Command command);
+
+  //! The latest published snapshot (never null). Cheap: copies a shared_ptr under the lock.
+  SnapshotPtr latest() const;
+  //! Version of the latest snapshot (0 before the first publication).
+  std::uint64_t version() const;
+
+  //! Blocks until a published snapshot satisfies \p pred or \p timeout passes; returns the
+  //! latest snapshot either way (for tests and headless use).
+  SnapshotPtr wait_for(const std::function<bool(const Snapshot&)>& pred,
+                       std::chrono::milliseconds timeout) const;
+
+  //! Number of commands waiting in the queue (for tests).
+  std::size_t queued() const;
+
+ private:
+  struct Queued {
+    std::uint64_t seq;
+    Command command;
+  };
+  void run(std::stop_token stop);
+  void publish(const Snapshot& base);
+
+  StepFunction step_;
+  mutable std::mutex mutex_;
+  mutable std::condition_variable_any queue_cv_;  // wakes the worker
+  mutable std::condition_variable publish_cv_;    // wakes wait_for
+  std::deque<Queued> queue_;                      // guarded by mutex_
+  std::uint64_t next_seq_ = 1;                    // guarded by mutex_
+  SnapshotPtr latest_;                            // guarded by mutex_
+  std::uint64_t version_ = 0;                     // guarded by mutex_
+  std::atomic<std::uint64_t> generation_{0};      // bumped by structural commands
+  std::jthread thread_;                           // last: starts after the members above
+};
+
+}  // namespace qs

@@ -1,0 +1,137 @@
+#include "render/camera.h"
+
+#include <algorithm>
+#include <cmath>
+#include <glm/gtc/matrix_transform.hpp>
+
+namespace qs::render {
+
+void Camera::set_viewport(int width, int height) {
+  width_ = std::max(1, width);
+  height_ = std::max(1, height);
+}
+
+void Camera::set_scene(const glm::vec3& center, float radius) {
+  scene_center_ = center;
+  scene_radius_ = radius > 0.0f && std::isfinite(radius) ? radius : 1.0f;
+}
+
+void Camera::reset(bool immediate) {
+  goal_rotation_ = glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+  goal_target_ = scene_center_;
+  goal_distance_ = scene_radius_ / std::sin(0.5f * fov_y_rad_) * 1.05f;
+  animating_ = true;
+  if (immediate) {
+    rotation_ = goal_rotation_;
+    target_ = goal_target_;
+    distance_ = goal_distance_;
+    animating_ = false;
+  }
+}
+
+void Camera::focus(const glm::vec3& center, float radius) {
+  goal_rotation_ = rotation_;
+  goal_target_ = center;
+  // Never zoom in so far that a single vertex fills the screen.
+  const float r = std::max(radius, 0.02f * scene_radius_);
+  goal_distance_ = r / std::sin(0.5f * fov_y_rad_) * 2.0f;
+  animating_ = true;
+}
+
+bool Camera::update(float dt) {
+  if (!animating_) return false;
+  // Exponential approach: frame-rate independent and never overshoots.
+  const float a = 1.0f - std::exp(-dt * 12.0f);
+  target_ = glm::mix(target_, goal_target_, a);
+  distance_ = glm::mix(distance_, goal_distance_, a);
+  rotation_ = glm::normalize(glm::slerp(rotation_, goal_rotation_, a));
+  if (glm::length(target_ - goal_target_) < 1e-4f * scene_radius_ &&
+      std::abs(distance_ - goal_distance_) < 1e-4f * scene_radius_ &&
+      std::abs(glm::dot(rotation_, goal_rotation_)) > 1.0f - 1e-7f) {
+    target_ = goal_target_;
+    distance_ = goal_distance_;
+    rotation_ = goal_rotation_;
+    animating_ = false;
+  }
+  return true;
+}
+
+glm::vec3 Camera::sphere_point(const glm::vec2& screen) const {
+  // Bell's virtual trackball: a sphere in the middle glued to a hyperbolic sheet, so that
+  // drags outside the sphere still rotate smoothly (mostly around the view axis).
+  const float s = 2.0f / float(std::min(width_, height_));
+  const glm::vec2 p((screen.x - 0.5f * width_) * s, (0.5f * height_ - screen.y) * s);
+  const float r2 = glm::dot(p, p);
+  const float z = r2 <= 0.5f ? std::sqrt(1.0f - r2) : 0.5f / std::sqrt(r2);
+  return glm::normalize(glm::vec3(p, z));
+}
+
+void Camera::begin_orbit(const glm::vec2& screen) {
+  animating_ = false;
+  orbit_last_ = sphere_point(screen);
+}
+
+void Camera::orbit_to(const glm::vec2& screen) {
+  const glm::vec3 p = sphere_point(screen);
+  const glm::vec3 axis = glm::cross(orbit_last_, p);
+  const float len = glm::length(axis);
+  if (len > 1e-7f) {
+    // The rotation is expressed in view space, hence applied on the left.
+    const float angle = std::atan2(len, glm::dot(orbit_last_, p)) * 1.5f;
+    rotation_ = glm::normalize(glm::angleAxis(angle, axis / len) * rotation_);
+  }
+  orbit_last_ = p;
+}
+
+void Camera::pan(const glm::vec2& delta) {
+  animating_ = false;
+  // World size of one pixel at the target's depth.
+  const float pixel = 2.0f * distance_ * std::tan(0.5f * fov_y_rad_) / float(height_);
+  const glm::mat3 to_world = glm::mat3_cast(glm::conjugate(rotation_));
+  target_ -= to_world * glm::vec3(delta.x * pixel, -delta.y * pixel, 0.0f);
+}
+
+void Camera::zoom(float steps) {
+  animating_ = false;
+  distance_ *= std::pow(0.88f, steps);
+  distance_ = std::clamp(distance_, 1e-3f * scene_radius_, 50.0f * scene_radius_);
+}
+
+glm::mat4 Camera::view() const {
+  return glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.0f, -distance_)) *
+         glm::mat4_cast(rotation_) * glm::translate(glm::mat4(1.0f), -target_);
+}
+
+glm::mat4 Camera::projection() const {
+  // Clip planes hug the scene sphere for depth precision, but stay valid when the camera
+  // is inside it.
+  const float to_center = glm::length(eye() - scene_center_);
+  const float far_plane = to_center + 1.5f * scene_radius_;
+  const float near_plane = std::max(to_center - 1.5f * scene_radius_, 1e-3f * far_plane);
+  return glm::perspective(fov_y_rad_, float(width_) / float(height_), near_plane, far_plane);
+}
+
+glm::vec3 Camera::eye() const {
+  return target_ + glm::mat3_cast(glm::conjugate(rotation_)) * glm::vec3(0.0f, 0.0f, distance_);
+}
+
+Ray Camera::ray(const glm::vec2& screen) const {
+  const glm::mat4 inverse = glm::inverse(projection() * view());
+  const float x = 2.0f * screen.x / float(width_) - 1.0f;
+  const float y = 1.0f - 2.0f * screen.y / float(height_);
+  glm::vec4 a = inverse * glm::vec4(x, y, -1.0f, 1.0f);
+  glm::vec4 b = inverse * glm::vec4(x, y, 1.0f, 1.0f);
+  Ray r;
+  r.origin = glm::dvec3(glm::vec3(a) / a.w);
+  r.direction = glm::normalize(glm::dvec3(glm::vec3(b) / b.w) - r.origin);
+  return r;
+}
+
+glm::vec3 Camera::project(const glm::vec3& world) const {
+  const glm::vec4 clip = projection() * view() * glm::vec4(world, 1.0f);
+  if (clip.w <= 0.0f) return {-1e9f, -1e9f, 2.0f};
+  const glm::vec3 ndc = glm::vec3(clip) / clip.w;
+  return {(ndc.x * 0.5f + 0.5f) * float(width_), (0.5f - ndc.y * 0.5f) * float(height_), ndc.z};
+}
+
+}  // namespace qs::render

@@ -1,0 +1,62 @@
+// Render layers (polyscope's Quantity idea): each layer mirrors some scene data on the GPU,
+// re-uploads only when that data's version changed, draws itself and offers an ImGui section.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/layout/layout.h"
+#include "core/mesh/mesh.h"
+#include "render/camera.h"
+
+namespace qs::render {
+
+//! Everything the layers may show, as non-owning views plus version counters. The app fills
+//! it every frame; a layer compares versions with what it uploaded last.
+struct SceneData {
+  const TriMesh* mesh = nullptr;
+  std::uint64_t mesh_version = 0;
+  const Layout* layout = nullptr;
+  std::uint64_t layout_version = 0;
+  //! Parameterization: uv per corner (size 3·#F) and per-face fold-over flags (size #F).
+  //! Either may be null/empty.
+  const std::vector<std::array<float, 2>>* corner_uv = nullptr;
+  const std::vector<char>* face_foldover = nullptr;
+  std::uint64_t param_version = 0;
+  //! Validation problems to highlight: mesh vertices, node ids and arc ids.
+  std::vector<int> issue_vertices;
+  std::vector<int> issue_nodes;
+  std::vector<int> issue_arcs;
+  std::uint64_t issues_version = 0;
+  //! Interaction state (ids; -1 for none) and a preview vertex path (arc tool).
+  int selected_node = -1;
+  int selected_arc = -1;
+  int hovered_node = -1;
+  int hovered_arc = -1;
+  int arc_start_node = -1;
+  std::vector<int> preview_path;
+  std::uint64_t interaction_version = 0;
+};
+
+//! Per-frame drawing context.
+struct FrameContext {
+  const Camera* camera = nullptr;
+  glm::ivec2 framebuffer{1, 1};  //!< pixels
+  float pixel_ratio = 1.0f;      //!< framebuffer pixels per window pixel
+  double time_s = 0.0;           //!< for animations (pulsing highlights)
+};
+
+class Layer {
+ public:
+  virtual ~Layer() = default;
+  virtual const char* name() const = 0;
+  //! Mirrors \p data on the GPU when its versions changed. Main thread, GL context current.
+  virtual void upload(const SceneData& data) = 0;
+  virtual void draw(const FrameContext& frame) = 0;
+  //! ImGui controls of the layer (inside an already open panel).
+  virtual void ui() {}
+  bool visible = true;
+};
+
+}  // namespace qs::render

@@ -1,0 +1,241 @@
+#include "render/layout_layer.h"
+
+#include <imgui.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <unordered_map>
+#include <unordered_set>
+
+namespace qs::render {
+
+glm::vec3 LayoutColors::valence(int valence) {
+  switch (valence) {
+    case 4: return {0.93f, 0.93f, 0.91f};  // regular: neutral
+    case 3: return {0.22f, 0.56f, 0.97f};
+    case 5: return {0.97f, 0.47f, 0.13f};
+    default: return {0.78f, 0.28f, 0.88f};  // anything else stands out
+  }
+}
+
+glm::vec3 LayoutColors::label(const std::string& label) {
+  if (label == "u") return {0.89f, 0.30f, 0.24f};
+  if (label == "v") return {0.16f, 0.66f, 0.42f};
+  return {0.14f, 0.16f, 0.22f};  // unknown: dark slate, readable on the light surface
+}
+
+namespace {
+
+constexpr int kLineFloats = 11;   // p0, p1, rgba, width
+constexpr int kPointFloats = 9;   // position, rgba, size, ring
+
+void push_point(std::vector<float>& out, const glm::vec3& p, const glm::vec3& c, float alpha,
+                float size, float ring) {
+  out.insert(out.end(), {p.x, p.y, p.z, c.r, c.g, c.b, alpha, size, ring});
+}
+
+void push_polyline(std::vector<float>& out, const std::vector<glm::vec3>& points,
+                   const glm::vec3& c, float width) {
+  for (std::size_t i = 0; i + 1 < points.size(); ++i) {
+    const auto& a = points[i];
+    const auto& b = points[i + 1];
+    out.insert(out.end(), {a.x, a.y, a.z, b.x, b.y, b.z, c.r, c.g, c.b, 1.0f, width});
+  }
+}
+
+glm::vec3 vertex_position(const TriMesh& mesh, int v) {
+  const auto& p = mesh.point(OpenMesh::VertexHandle(v));
+  return {float(p[0]), float(p[1]), float(p[2])};
+}
+
+bool valid_vertex(const TriMesh& mesh, int v) { return v >= 0 && v < int(mesh.n_vertices()); }
+
+}  // namespace
+
+LayoutLayer::LayoutLayer() {
+  std::string log;
+  if (!reload(&log)) throw std::runtime_error("layout shaders: " + log);
+}
+
+bool LayoutLayer::reload(std::string* log) {
+  return lines_.build("lines.vert", "lines.frag", log) &&
+         points_.build("points.vert", "points.frag", log);
+}
+
+void LayoutLayer::upload(const SceneData& data) {
+  const std::vector<std::uint64_t> key = {
+      reinterpret_cast<std::uintptr_t>(data.mesh), data.mesh_version,
+      reinterpret_cast<std::uintptr_t>(data.layout), data.layout_version, data.issues_version,
+      data.interaction_version};
+  if (key == uploaded_key_) return;
+  uploaded_key_ = key;
+  arc_segments_ = nodes_ = issue_points_ = 0;
+  if (!data.mesh) return;
+  const TriMesh& mesh = *data.mesh;
+
+  // Scene scale: used to pull lines/points towards the camera by a size-relative amount.
+  if (mesh.n_vertices() > 0) {
+    auto lo = vertex_position(mesh, 0), hi = lo;
+    for (auto vh : mesh.vertices()) {
+      const auto p = vertex_position(mesh, vh.idx());
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+    scene_scale_ = std::max(glm::length(hi - lo), 1e-6f);
+  }
+
+  const std::unordered_set<int> bad_nodes(data.issue_nodes.begin(), data.issue_nodes.end());
+  const std::unordered_set<int> bad_arcs(data.issue_arcs.begin(), data.issue_arcs.end());
+
+  std::vector<float> lines, points, issues;
+  if (data.layout) {
+    const Layout& layout = *data.layout;
+    std::unordered_map<int, int> valence;
+    for (const auto& arc : layout.arcs) {
+      ++valence[arc.from];
+      if (arc.to >= 0) ++valence[arc.to];
+    }
+    // Pinned arcs first (a wide gold underlay), then every arc on top.
+    std::vector<glm::vec3> poly;
+    for (int pass = 0; pass < 2; ++pass) {
+      for (const auto& arc : layout.arcs) {
+        if (pass == 0 && !arc.pinned && arc.id != data.selected_arc) continue;
+        poly.clear();
+        if (!arc.polyline.empty()) {
+          for (const auto& p : arc.polyline) poly.emplace_back(p[0], p[1], p[2]);
+        } else {
+          for (int v : arc.path)
+            if (valid_vertex(mesh, v)) poly.push_back(vertex_position(mesh, v));
+        }
+        if (poly.size() < 2) continue;
+        if (pass == 0) {
+          const bool selected = arc.id == data.selected_arc;
+          push_polyline(lines, poly, selected ? LayoutColors::kSelected : LayoutColors::kPin,
+                        arc_width * (selected ? 2.6f : 2.2f));
+          continue;
+        }
+        glm::vec3 color = LayoutColors::label(arc.label);
+        if (bad_arcs.count(arc.id)) color = LayoutColors::kProblem;
+        if (arc.id == data.hovered_arc) color = glm::mix(color, glm::vec3(1.0f), 0.45f);
+        push_polyline(lines, poly, color, arc_width);
+      }
+    }
+    for (const auto& node : layout.nodes) {
+      glm::vec3 p;
+      if (valid_vertex(mesh, node.vertex)) {
+        p = vertex_position(mesh, node.vertex);
+      } else if (node.position) {
+        p = {float((*node.position)[0]), float((*node.position)[1]), float((*node.position)[2])};
+      } else {
+        continue;
+      }
+      const auto it = valence.find(node.id);
+      glm::vec3 color = LayoutColors::valence(it == valence.end() ? 0 : it->second);
+      if (bad_nodes.count(node.id)) color = LayoutColors::kProblem;
+      float size = node_size;
+      if (node.id == data.hovered_node || node.id == data.arc_start_node) size *= 1.3f;
+      const float ring = node.id == data.selected_node || node.id == data.arc_start_node ? 2.0f
+                         : node.pinned                                                 ? 1.0f
+                                                                                       : 0.0f;
+      if (ring > 0.0f) size *= 1.25f;
+      push_point(points, p, color, 1.0f, size, ring);
+    }
+  }
+  if (data.preview_path.size() >= 2) {
+    std::vector<glm::vec3> poly;
+    for (int v : data.preview_path)
+      if (valid_vertex(mesh, v)) poly.push_back(vertex_position(mesh, v));
+    push_polyline(lines, poly, LayoutColors::kPreview, arc_width * 0.8f);
+  }
+  for (int v : data.issue_vertices)
+    if (valid_vertex(mesh, v))
+      push_point(issues, vertex_position(mesh, v), LayoutColors::kProblem, 0.9f, node_size * 0.8f,
+                 0.0f);
+
+  auto upload_to = [](GlVertexArray& vao, GlBuffer& buffer, const std::vector<float>& data,
+                      bool lines_format) {
+    if (data.empty()) return;
+    buffer.upload(data.data(), data.size() * sizeof(float), GL_DYNAMIC_DRAW);
+    if (lines_format) {
+      vao.attribute(0, buffer, 3, kLineFloats, 0, 1);
+      vao.attribute(1, buffer, 3, kLineFloats, 3, 1);
+      vao.attribute(2, buffer, 4, kLineFloats, 6, 1);
+      vao.attribute(3, buffer, 1, kLineFloats, 10, 1);
+    } else {
+      vao.attribute(0, buffer, 3, kPointFloats, 0);
+      vao.attribute(1, buffer, 4, kPointFloats, 3);
+      vao.attribute(2, buffer, 1, kPointFloats, 7);
+      vao.attribute(3, buffer, 1, kPointFloats, 8);
+    }
+  };
+  upload_to(arc_vao_, arc_buffer_, lines, true);
+  upload_to(node_vao_, node_buffer_, points, false);
+  upload_to(issue_vao_, issue_buffer_, issues, false);
+  arc_segments_ = static_cast<int>(lines.size() / kLineFloats);
+  nodes_ = static_cast<int>(points.size() / kPointFloats);
+  issue_points_ = static_cast<int>(issues.size() / kPointFloats);
+}
+
+void LayoutLayer::draw_lines(const FrameContext& frame, GlVertexArray& vao, int count,
+                             float pull) {
+  lines_.use();
+  lines_.set("u_view", frame.camera->view());
+  lines_.set("u_proj", frame.camera->projection());
+  lines_.set("u_viewport", glm::vec2(frame.framebuffer));
+  lines_.set("u_pixel_ratio", frame.pixel_ratio);
+  lines_.set("u_pull", pull);
+  lines_.set("u_width_scale", 1.0f);
+  vao.bind();
+  glDrawArraysInstanced(GL_TRIANGLES, 0, 6, count);
+}
+
+void LayoutLayer::draw_points(const FrameContext& frame, GlVertexArray& vao, int count,
+                              float scale, float pull) {
+  points_.use();
+  points_.set("u_view", frame.camera->view());
+  points_.set("u_proj", frame.camera->projection());
+  points_.set("u_pixel_ratio", frame.pixel_ratio);
+  points_.set("u_pull", pull);
+  points_.set("u_size_scale", scale);
+  vao.bind();
+  glDrawArrays(GL_POINTS, 0, count);
+}
+
+void LayoutLayer::draw(const FrameContext& frame) {
+  if (!visible) return;
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  glEnable(GL_PROGRAM_POINT_SIZE);
+  // Overlays are lifted towards the camera by a small fraction of the scene so they sit on
+  // the surface without z-fighting yet stay hidden behind it from the other side.
+  const float pull = 0.004f * scene_scale_;
+  if (show_arcs && arc_segments_ > 0) {
+    glDepthMask(GL_FALSE);  // overlapping translucent edges must not occlude each other
+    draw_lines(frame, arc_vao_, arc_segments_, pull);
+    glDepthMask(GL_TRUE);
+  }
+  if (show_nodes && nodes_ > 0) draw_points(frame, node_vao_, nodes_, 1.0f, 2.0f * pull);
+  if (show_issues && issue_points_ > 0) {
+    // Pulsing draws the eye to problems without hiding what is underneath.
+    const float pulse = 1.0f + 0.35f * float(std::sin(frame.time_s * 5.0));
+    draw_points(frame, issue_vao_, issue_points_, pulse, 2.5f * pull);
+  }
+  glDisable(GL_BLEND);
+}
+
+void LayoutLayer::ui() {
+  bool changed = false;
+  ImGui::Checkbox("Layout", &visible);
+  ImGui::SameLine();
+  ImGui::Checkbox("Nodes", &show_nodes);
+  ImGui::SameLine();
+  ImGui::Checkbox("Arcs", &show_arcs);
+  ImGui::SameLine();
+  ImGui::Checkbox("Problems", &show_issues);
+  changed |= ImGui::SliderFloat("Node size", &node_size, 4.0f, 40.0f, "%.0f px");
+  changed |= ImGui::SliderFloat("Arc width", &arc_width, 1.0f, 12.0f, "%.1f px");
+  if (changed) uploaded_key_.clear();  // sizes are baked into the instance data
+}
+
+}  // namespace qs::render

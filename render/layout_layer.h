@@ -1,0 +1,54 @@
+// The quad layout on the surface: arcs as thick polylines coloured by their u/v label, nodes
+// as sphere impostors coloured by valence, pins and selection marked, validation problems
+// highlighted (pulsing red vertices, red arcs and nodes).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "render/gl_util.h"
+#include "render/layers.h"
+
+namespace qs::render {
+
+//! Colours shared with the UI legend.
+struct LayoutColors {
+  static glm::vec3 valence(int valence);
+  static glm::vec3 label(const std::string& label);
+  static constexpr glm::vec3 kSelected{1.0f, 0.86f, 0.15f};
+  static constexpr glm::vec3 kProblem{0.95f, 0.10f, 0.10f};
+  static constexpr glm::vec3 kPreview{1.0f, 0.60f, 0.10f};
+  static constexpr glm::vec3 kPin{0.98f, 0.78f, 0.20f};
+};
+
+class LayoutLayer : public Layer {
+ public:
+  //! \throw std::runtime_error if the shaders do not compile.
+  LayoutLayer();
+  const char* name() const override { return "Layout"; }
+  void upload(const SceneData& data) override;
+  void draw(const FrameContext& frame) override;
+  void ui() override;
+  bool reload(std::string* log);
+
+  bool show_nodes = true;
+  bool show_arcs = true;
+  bool show_issues = true;
+  float node_size = 14.0f;  //!< window pixels
+  float arc_width = 4.0f;   //!< window pixels
+
+ private:
+  void draw_lines(const FrameContext& frame, GlVertexArray& vao, int count, float pull);
+  void draw_points(const FrameContext& frame, GlVertexArray& vao, int count, float scale,
+                   float pull);
+
+  GlProgram lines_;
+  GlProgram points_;
+  GlVertexArray arc_vao_, node_vao_, issue_vao_;
+  GlBuffer arc_buffer_, node_buffer_, issue_buffer_;
+  int arc_segments_ = 0, nodes_ = 0, issue_points_ = 0;
+  float scene_scale_ = 1.0f;
+  std::vector<std::uint64_t> uploaded_key_;
+};
+
+}  // namespace qs::render

@@ -1,0 +1,46 @@
+# GUI tests: the layout editor unit (GL-free app code) and smoke tests of the quadsketch
+# executable (screenshot under Xvfb, exit codes). Included by tests/CMakeLists.txt.
+
+# layout_editor_test.cpp is picked up by the *_test.cpp glob, which links qs_core only: add
+# the app sources it exercises (all GL-free).
+if(TARGET layout_editor_test)
+  target_sources(layout_editor_test PRIVATE
+    ${PROJECT_SOURCE_DIR}/app/gui/layout_editor.cpp
+    ${PROJECT_SOURCE_DIR}/app/gui/autosave.cpp
+    ${PROJECT_SOURCE_DIR}/app/gui/recent_files.cpp)
+endif()
+
+if(NOT QS_BUILD_APP)
+  return()
+endif()
+
+add_executable(gui_smoke_check ${CMAKE_CURRENT_LIST_DIR}/../gui_smoke_check.cpp)
+target_link_libraries(gui_smoke_check PRIVATE PkgConfig::IMGUI)  # brings libstb (stb_image)
+add_dependencies(gui_smoke_check quadsketch)
+
+set(QS_GUI_SMOKE_DIR ${CMAKE_CURRENT_BINARY_DIR}/gui_smoke)
+file(MAKE_DIRECTORY ${QS_GUI_SMOKE_DIR})
+# Keep the tests away from the user's ~/.config and ~/.cache.
+set(QS_GUI_TEST_ENV
+  "LIBGL_ALWAYS_SOFTWARE=1"
+  "QS_AUTOSAVE_DIR=${QS_GUI_SMOKE_DIR}/autosave"
+  "XDG_CONFIG_HOME=${QS_GUI_SMOKE_DIR}/config")
+
+# Screenshot of the bundled example after 5 frames; skipped (77) without xvfb-run.
+add_test(NAME gui_smoke_screenshot
+  COMMAND gui_smoke_check screenshot --app $<TARGET_FILE:quadsketch>
+    --mesh ${QS_ASSETS_DIR}/example/ellipsoid.obj
+    --layout ${QS_ASSETS_DIR}/example/ellipsoid.layout.json
+    --out ${QS_GUI_SMOKE_DIR}/example.png --width 1280 --height 800)
+set_tests_properties(gui_smoke_screenshot PROPERTIES
+  SKIP_RETURN_CODE 77 TIMEOUT 120 ENVIRONMENT "${QS_GUI_TEST_ENV}")
+
+# Bad input with --quit: message on stderr, exit code 2, no crash (and no display needed).
+add_test(NAME gui_bad_mesh_exits_2
+  COMMAND gui_smoke_check exit-code --app $<TARGET_FILE:quadsketch> --expect 2 --
+    --mesh ${QS_ASSETS_DIR}/bad/nonmanifold_edge.obj --quit)
+add_test(NAME gui_missing_mesh_exits_2
+  COMMAND gui_smoke_check exit-code --app $<TARGET_FILE:quadsketch> --expect 2 --
+    --mesh ${QS_GUI_SMOKE_DIR}/does_not_exist.obj --quit)
+set_tests_properties(gui_bad_mesh_exits_2 gui_missing_mesh_exits_2 PROPERTIES
+  TIMEOUT 60 ENVIRONMENT "${QS_GUI_TEST_ENV}")

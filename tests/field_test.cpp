@@ -1,0 +1,263 @@
+// Guiding cross field: topology fixed by the layout, smoothness, alignment (issue #3).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numeric>
+#include <random>
+#include <set>
+
+#include "core/base/errors.h"
+#include "core/field/cross_field.h"
+#include "core/field/curvature.h"
+#include "core/field/topology.h"
+#include "core/layout/validate.h"
+#include "core/mesh/geometry.h"
+#include "tests/fixtures.h"
+
+namespace qs {
+namespace {
+
+struct Solved {
+  GeometryCache geometry;
+  LayoutTopology topology;
+  CrossField field;
+  std::vector<int> indices;  // measured on the field, quarter turns
+};
+
+Solved solve_field(const test::MeshAndLayout& in, unsigned frame_seed = 0,
+                   CrossFieldOptions opt = {}) {
+  const auto validation = validate_layout(in.mesh, in.layout);
+  EXPECT_TRUE(validation.valid());
+  for (const auto& i : validation.issues) ADD_FAILURE() << format_issue(i);
+  Solved s;
+  s.geometry = build_geometry(in.mesh);
+  if (frame_seed) {
+    std::mt19937 rng(frame_seed);
+    std::uniform_real_distribution<double> angle(-M_PI, M_PI);
+    std::vector<double> offsets(in.mesh.n_faces());
+    for (double& o : offsets) o = angle(rng);
+    set_frame_offsets(in.mesh, s.geometry, offsets);
+  }
+  s.topology = build_topology(in.mesh, in.layout);
+  s.field = compute_cross_field(in.mesh, s.geometry, in.layout, s.topology, opt);
+  s.indices = field_quarter_indices(s.geometry, s.field.theta);
+  return s;
+}
+
+int euler(const TriMesh& m) {
+  return static_cast<int>(m.n_vertices()) - static_cast<int>(m.n_edges()) +
+         static_cast<int>(m.n_faces());
+}
+
+// Every node vertex has index (4 − valence)/4, no other interior vertex is singular, the
+// principal matching of the solved field reproduces the prescribed period jumps, and the
+// indices sum to the Euler characteristic (closed surfaces).
+void expect_layout_singularities(const test::MeshAndLayout& in, const Solved& s) {
+  std::vector<int> expected(in.mesh.n_vertices(), 0);
+  for (int n = 0; n < s.topology.num_nodes; ++n)
+    expected[in.layout.nodes[n].vertex] = 4 - s.topology.valence[n];
+  int wrong = 0;
+  for (auto v : in.mesh.vertices()) {
+    if (in.mesh.is_boundary(v)) continue;
+    if (s.indices[v.idx()] != expected[v.idx()]) {
+      if (++wrong < 5)
+        ADD_FAILURE() << "vertex " << v.idx() << ": index " << s.indices[v.idx()] << "/4, expected "
+                      << expected[v.idx()] << "/4";
+    }
+  }
+  EXPECT_EQ(wrong, 0);
+  const auto matching = principal_matching(s.geometry, s.field.theta);
+  int mismatched = 0;
+  for (size_t e = 0; e < matching.size(); ++e) mismatched += matching[e] != s.field.period_jump[e];
+  EXPECT_EQ(mismatched, 0) << "field steps of more than 45° across edges";
+  if (in.mesh.is_boundary(in.mesh.vertex_handle(0)) == false &&
+      s.geometry.vertex_on_boundary.end() == std::find(s.geometry.vertex_on_boundary.begin(),
+                                                       s.geometry.vertex_on_boundary.end(), 1)) {
+    EXPECT_EQ(std::accumulate(s.indices.begin(), s.indices.end(), 0), 4 * euler(in.mesh));
+  }
+}
+
+// Largest misalignment (degrees, mod 90°) between the field and the arcs, over every arc edge.
+double max_arc_misalignment_deg(const test::MeshAndLayout& in, const Solved& s) {
+  double worst = 0;
+  for (const auto& arc : in.layout.arcs) {
+    for (size_t k = 0; k + 1 < arc.path.size(); ++k) {
+      auto h = in.mesh.find_halfedge(in.mesh.vertex_handle(arc.path[k]),
+                                     in.mesh.vertex_handle(arc.path[k + 1]));
+      if (in.mesh.is_boundary(h)) h = in.mesh.opposite_halfedge_handle(h);
+      const int f = in.mesh.face_handle(h).idx();
+      const Vec3 t =
+          in.mesh.point(in.mesh.to_vertex_handle(h)) - in.mesh.point(in.mesh.from_vertex_handle(h));
+      const double d = s.field.theta[f] - s.geometry.angle_in_face(f, t);
+      const double r = std::remainder(d, M_PI / 2);
+      worst = std::max(worst, std::abs(r) * 180 / M_PI);
+    }
+  }
+  return worst;
+}
+
+TEST(CrossField, CubeOnSphereHasQuarterSingularitiesAtTheNodes) {
+  const auto in = test::cube_sphere(8);
+  for (unsigned seed : {0u, 7u}) {
+    const Solved s = solve_field(in, seed);
+    expect_layout_singularities(in, s);
+    int positive = 0;
+    for (int i : s.indices) positive += (i == 1);
+    EXPECT_EQ(positive, 8);
+  }
+}
+
+TEST(CrossField, RandomFramesGiveTheSameField) {
+  // The field direction per face must not depend on the reference frames.
+  const auto in = test::cube_sphere(6, Vec3(1.3, 1.0, 0.75));
+  const Solved a = solve_field(in, 0), b = solve_field(in, 11);
+  const auto da = field_directions(a.geometry, a.field.theta),
+             db = field_directions(b.geometry, b.field.theta);
+  double worst = 0;
+  for (size_t f = 0; f < da.size(); ++f) {
+    const double cross = (da[f] % db[f]).norm(), dot = da[f] | db[f];
+    worst = std::max(worst, std::abs(std::remainder(std::atan2(cross, dot), M_PI / 2)));
+  }
+  EXPECT_LT(worst * 180 / M_PI, 1e-6);
+  EXPECT_GT(b.field.topology.max_abs_jump, 4) << "random frames should produce large period jumps";
+}
+
+TEST(CrossField, TorusGridHasNoSingularityAndNoTwist) {
+  const auto in = test::torus_grid(32, 16, 4, 2);
+  for (unsigned seed : {0u, 3u}) {
+    const Solved s = solve_field(in, seed);
+    expect_layout_singularities(in, s);
+    EXPECT_EQ(std::count(s.indices.begin(), s.indices.end(), 0),
+              static_cast<long>(in.mesh.n_vertices()));
+    EXPECT_EQ(s.field.topology.free_unknowns, 2);
+    // A wrong generator turning number would sweep the misalignment through ±45°.
+    EXPECT_LT(max_arc_misalignment_deg(in, s), 10.0);
+  }
+}
+
+TEST(CrossField, Genus2PolycubeFollowsEveryArc) {
+  const auto in = test::genus2_polycube(3);
+  const auto topo = build_topology(in.mesh, in.layout);
+  std::set<int> valences(topo.valence.begin(), topo.valence.end());
+  EXPECT_TRUE(valences.count(3) && valences.count(4) && valences.count(5));
+  EXPECT_EQ(euler(in.mesh), -2);
+  for (unsigned seed : {0u, 5u}) {
+    const Solved s = solve_field(in, seed);
+    expect_layout_singularities(in, s);
+    EXPECT_EQ(s.field.topology.free_unknowns, 4);
+    EXPECT_EQ(s.field.topology.rank, 4);
+    // Flat patches with sharp edges along every arc: the field follows every arc exactly.
+    EXPECT_LT(max_arc_misalignment_deg(in, s), 1.0);
+  }
+}
+
+TEST(CrossField, BoundaryAlignedSaddle) {
+  auto in = test::disk_grid(12, 12, 3, 3);
+  for (auto v : in.mesh.vertices()) {
+    auto p = in.mesh.point(v);
+    p[2] = 0.04 * ((p[0] - 6) * (p[0] - 6) - (p[1] - 6) * (p[1] - 6));
+    in.mesh.set_point(v, p);
+  }
+  const Solved s = solve_field(in, 9);
+  expect_layout_singularities(in, s);
+  EXPECT_EQ(std::count(s.indices.begin(), s.indices.end(), 0),
+            static_cast<long>(in.mesh.n_vertices()));
+  // Along boundary edges the field is parallel to the boundary.
+  double worst = 0;
+  for (size_t k = 0; k < s.field.constraints.face.size(); ++k) {
+    if (s.field.constraints.kind[k] != ConstraintKind::Boundary) continue;
+    const int f = s.field.constraints.face[k];
+    const double d =
+        s.field.theta[f] - s.geometry.angle_in_face(f, s.field.constraints.direction[k]);
+    worst = std::max(worst, std::abs(std::remainder(d, M_PI / 2)) * 180 / M_PI);
+  }
+  EXPECT_LT(worst, 2.0);
+}
+
+TEST(CrossField, FollowsPrincipalDirectionsOnATorus) {
+  const auto in = test::torus_grid(64, 24, 4, 2);
+  const Solved s = solve_field(in);
+  const GeometryCache& g = s.geometry;
+  const Curvature curv = compute_curvature(in.mesh, g);
+  ASSERT_GT(curv.reliable_faces, static_cast<int>(in.mesh.n_faces()) / 2);
+  // Exact principal directions of the torus: the parallel (around the z axis) and the meridian.
+  double sum = 0, sum_estimate = 0;
+  int count = 0;
+  for (auto f : in.mesh.faces()) {
+    if (!curv.reliable[f.idx()]) continue;
+    const Vec3 c = in.mesh.calc_face_centroid(f);
+    const Vec3 parallel = Vec3(-c[1], c[0], 0).normalized();
+    const double d = s.field.theta[f.idx()] - g.angle_in_face(f.idx(), parallel);
+    sum += std::abs(std::remainder(d, M_PI / 2)) * 180 / M_PI;
+    const double de =
+        g.angle_in_face(f.idx(), curv.dir_max[f.idx()]) - g.angle_in_face(f.idx(), parallel);
+    sum_estimate += std::abs(std::remainder(de, M_PI / 2)) * 180 / M_PI;
+    ++count;
+  }
+  EXPECT_LT(sum / count, 2.0) << "mean deviation of the field from the principal directions";
+  EXPECT_LT(sum_estimate / count, 2.0) << "mean error of the curvature estimate";
+}
+
+TEST(CrossField, ParallelToSharpFeatures) {
+  const auto in = test::cube_sphere(6, Vec3(1, 1, 1), /*project=*/false);
+  const Solved s = solve_field(in, 4);
+  expect_layout_singularities(in, s);
+  const auto sharp = sharp_edges(in.mesh, s.geometry, 35.0);
+  int count = 0;
+  double worst = 0;
+  for (auto e : in.mesh.edges()) {
+    if (!sharp[e.idx()]) continue;
+    ++count;
+    const auto h = in.mesh.halfedge_handle(e, 0);
+    const Vec3 t =
+        in.mesh.point(in.mesh.to_vertex_handle(h)) - in.mesh.point(in.mesh.from_vertex_handle(h));
+    for (int f : {s.geometry.edge_face_i[e.idx()], s.geometry.edge_face_j[e.idx()]}) {
+      const double d = s.field.theta[f] - s.geometry.angle_in_face(f, t);
+      worst = std::max(worst, std::abs(std::remainder(d, M_PI / 2)) * 180 / M_PI);
+    }
+  }
+  EXPECT_EQ(count, 12 * 6);
+  EXPECT_LT(worst, 0.5);
+}
+
+TEST(CrossField, UndeterminedTopologyIsAnInputError) {
+  // Only the meridian arcs on a torus (annular patches, valence-2 nodes): such a layout has
+  // no realizable field topology; the construction must refuse clearly, naming the reason.
+  auto in = test::torus_grid(12, 8, 3, 2);
+  std::vector<LayoutArc> keep;
+  for (size_t i = 1; i < in.layout.arcs.size(); i += 2) keep.push_back(in.layout.arcs[i]);
+  in.layout.arcs = keep;
+  const GeometryCache g = build_geometry(in.mesh);
+  const LayoutTopology topo = build_topology(in.mesh, in.layout);
+  try {
+    compute_period_jumps(in.mesh, g, in.layout, topo);
+    FAIL() << "expected a TopologyError";
+  } catch (const TopologyError& e) {
+    const std::string msg = e.what();
+    EXPECT_TRUE(msg.find("Poincaré–Hopf") != std::string::npos ||
+                msg.find("does not determine") != std::string::npos)
+        << msg;
+  }
+}
+
+TEST(CrossField, ResolveReusesTheFactorization) {
+  auto in = test::cube_sphere(6, Vec3(1.3, 1.0, 0.75));
+  GeometryCache g = build_geometry(in.mesh);
+  const LayoutTopology topo = build_topology(in.mesh, in.layout);
+  CrossFieldSolver solver(in.mesh, g, in.layout, topo);
+  // Move one interior vertex a little: the re-solve keeps the topology.
+  auto v = in.mesh.vertex_handle(in.layout.nodes[0].vertex);
+  for (auto w : in.mesh.vv_range(v)) {
+    in.mesh.set_point(w, in.mesh.point(w) * 1.01);
+    break;
+  }
+  update_geometry(in.mesh, g);
+  const CrossField& f = solver.solve(g);
+  const auto idx = field_quarter_indices(g, f.theta);
+  int singular = 0;
+  for (int i : idx) singular += i != 0;
+  EXPECT_EQ(singular, 8);
+}
+
+}  // namespace
+}  // namespace qs

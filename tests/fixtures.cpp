@@ -1,0 +1,313 @@
+#include "tests/fixtures.h"
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+namespace qs::test {
+
+std::string shared_meshes_dir() {
+  const std::filesystem::path p = std::filesystem::path(QS_SHARED_DIR) / "data" / "meshes";
+  return std::filesystem::is_directory(p) ? p.string() : std::string();
+}
+
+std::string assets_dir() {
+  return QS_ASSETS_DIR;
+}
+
+std::string cli_path() {
+  return QS_CLI_PATH;
+}
+
+std::string temp_dir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("qs_test_" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+int run_command(const std::string& command, std::string* output) {
+  const std::string full = command + " 2>&1";
+  FILE* pipe = popen(full.c_str(), "r");
+  if (!pipe) return -1;
+  std::array<char, 4096> buffer{};
+  std::string text;
+  size_t n = 0;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) text.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  if (output) *output = text;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+namespace {
+
+// Adds the two triangles of quad (a,b,c,d) (ccw), alternating the diagonal with `flip`.
+void add_quad(TriMesh& mesh, int a, int b, int c, int d, bool flip) {
+  auto vh = [&](int i) { return mesh.vertex_handle(i); };
+  if (flip) {
+    mesh.add_face(vh(a), vh(b), vh(d));
+    mesh.add_face(vh(b), vh(c), vh(d));
+  } else {
+    mesh.add_face(vh(a), vh(b), vh(c));
+    mesh.add_face(vh(a), vh(c), vh(d));
+  }
+}
+
+LayoutNode make_node(int id, int vertex) {
+  LayoutNode n;
+  n.id = id;
+  n.vertex = vertex;
+  return n;
+}
+
+LayoutArc make_arc(int id, int from, int to, std::vector<int> path) {
+  LayoutArc a;
+  a.id = id;
+  a.from = from;
+  a.to = to;
+  a.path = std::move(path);
+  return a;
+}
+
+}  // namespace
+
+MeshAndLayout cube_sphere(int k, Vec3 radii, bool project) {
+  MeshAndLayout out;
+  TriMesh& mesh = out.mesh;
+  std::map<std::array<int, 3>, int> index;
+  auto vertex = [&](std::array<int, 3> ijk) {
+    auto it = index.find(ijk);
+    if (it != index.end()) return it->second;
+    Vec3 p(2.0 * ijk[0] / k - 1.0, 2.0 * ijk[1] / k - 1.0, 2.0 * ijk[2] / k - 1.0);
+    if (project) {
+      p.normalize();
+      p = Vec3(p[0] * radii[0], p[1] * radii[1], p[2] * radii[2]);
+    }
+    const int id = mesh.add_vertex(p).idx();
+    index.emplace(ijk, id);
+    return id;
+  };
+  for (int a = 0; a < 3; ++a) {
+    for (int s = 0; s <= k; s += k) {
+      // Axes (b, c) with e_b × e_c pointing outwards.
+      int b = (a + 1) % 3, c = (a + 2) % 3;
+      if (s == 0) std::swap(b, c);
+      for (int u = 0; u < k; ++u) {
+        for (int w = 0; w < k; ++w) {
+          auto at = [&](int du, int dw) {
+            std::array<int, 3> ijk{};
+            ijk[a] = s;
+            ijk[b] = u + du;
+            ijk[c] = w + dw;
+            return vertex(ijk);
+          };
+          add_quad(mesh, at(0, 0), at(1, 0), at(1, 1), at(0, 1), (u + w) % 2 == 1);
+        }
+      }
+    }
+  }
+  // Nodes at the 8 corners; arcs along the 12 cube edges.
+  std::map<std::array<int, 3>, int> node_of;
+  for (int x = 0; x <= k; x += k)
+    for (int y = 0; y <= k; y += k)
+      for (int z = 0; z <= k; z += k) {
+        const int id = static_cast<int>(out.layout.nodes.size());
+        out.layout.nodes.push_back(make_node(id, vertex({x, y, z})));
+        node_of[{x, y, z}] = id;
+      }
+  for (const auto& [corner, id] : node_of) {
+    for (int axis = 0; axis < 3; ++axis) {
+      if (corner[axis] != 0) continue;
+      std::vector<int> path;
+      std::array<int, 3> p = corner;
+      for (int t = 0; t <= k; ++t) {
+        p[axis] = t;
+        path.push_back(vertex(p));
+      }
+      const int to = node_of.at(p);
+      const int arc_id = static_cast<int>(out.layout.arcs.size());
+      out.layout.arcs.push_back(make_arc(arc_id, id, to, std::move(path)));
+    }
+  }
+  return out;
+}
+
+MeshAndLayout torus_grid(int nu, int nv, int pu, int pv, double R, double r) {
+  MeshAndLayout out;
+  TriMesh& mesh = out.mesh;
+  auto id = [&](int i, int j) { return ((i % nu + nu) % nu) * nv + ((j % nv + nv) % nv); };
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      const double t = 2 * M_PI * i / nu, f = 2 * M_PI * j / nv;
+      mesh.add_vertex(Vec3((R + r * std::cos(f)) * std::cos(t), (R + r * std::cos(f)) * std::sin(t),
+                           r * std::sin(f)));
+    }
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j)
+      add_quad(mesh, id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1), (i + j) % 2 == 1);
+  const int su = nu / pu, sv = nv / pv;
+  std::map<int, int> node_of;
+  for (int a = 0; a < pu; ++a)
+    for (int b = 0; b < pv; ++b) {
+      const int nid = static_cast<int>(out.layout.nodes.size());
+      out.layout.nodes.push_back(make_node(nid, id(a * su, b * sv)));
+      node_of[id(a * su, b * sv)] = nid;
+    }
+  for (int a = 0; a < pu; ++a)
+    for (int b = 0; b < pv; ++b) {
+      const int i0 = a * su, j0 = b * sv;
+      std::vector<int> pu_path, pv_path;
+      for (int t = 0; t <= su; ++t) pu_path.push_back(id(i0 + t, j0));
+      for (int t = 0; t <= sv; ++t) pv_path.push_back(id(i0, j0 + t));
+      const int from = node_of.at(id(i0, j0));
+      out.layout.arcs.push_back(make_arc(static_cast<int>(out.layout.arcs.size()), from,
+                                         node_of.at(pu_path.back()), pu_path));
+      out.layout.arcs.push_back(make_arc(static_cast<int>(out.layout.arcs.size()), from,
+                                         node_of.at(pv_path.back()), pv_path));
+    }
+  return out;
+}
+
+MeshAndLayout disk_grid(int nx, int ny, int px, int py) {
+  MeshAndLayout out;
+  TriMesh& mesh = out.mesh;
+  auto id = [&](int i, int j) { return j * (nx + 1) + i; };
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) mesh.add_vertex(Vec3(i, j, 0));
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i)
+      add_quad(mesh, id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1), (i + j) % 2 == 1);
+  const int sx = nx / px, sy = ny / py;
+  std::map<int, int> node_of;
+  for (int b = 0; b <= py; ++b)
+    for (int a = 0; a <= px; ++a) {
+      const int nid = static_cast<int>(out.layout.nodes.size());
+      out.layout.nodes.push_back(make_node(nid, id(a * sx, b * sy)));
+      node_of[id(a * sx, b * sy)] = nid;
+    }
+  for (int b = 0; b <= py; ++b)
+    for (int a = 0; a <= px; ++a) {
+      const int i0 = a * sx, j0 = b * sy;
+      if (a < px) {
+        std::vector<int> path;
+        for (int t = 0; t <= sx; ++t) path.push_back(id(i0 + t, j0));
+        out.layout.arcs.push_back(make_arc(static_cast<int>(out.layout.arcs.size()),
+                                           node_of.at(path.front()), node_of.at(path.back()),
+                                           path));
+      }
+      if (b < py) {
+        std::vector<int> path;
+        for (int t = 0; t <= sy; ++t) path.push_back(id(i0, j0 + t));
+        out.layout.arcs.push_back(make_arc(static_cast<int>(out.layout.arcs.size()),
+                                           node_of.at(path.front()), node_of.at(path.back()),
+                                           path));
+      }
+    }
+  return out;
+}
+
+MeshAndLayout voxel_surface(const std::vector<std::array<int, 3>>& voxels, int k) {
+  MeshAndLayout out;
+  TriMesh& mesh = out.mesh;
+  std::set<std::array<int, 3>> filled(voxels.begin(), voxels.end());
+  std::map<std::array<int, 3>, int> index;  // lattice point (scaled by k) -> vertex
+  auto vertex = [&](const std::array<int, 3>& q) {
+    auto it = index.find(q);
+    if (it != index.end()) return it->second;
+    const int id =
+        mesh.add_vertex(Vec3(double(q[0]) / k, double(q[1]) / k, double(q[2]) / k)).idx();
+    index.emplace(q, id);
+    return id;
+  };
+  // Boundary faces: a voxel side whose neighbour is empty.
+  for (const auto& c : voxels) {
+    for (int a = 0; a < 3; ++a) {
+      for (int s : {-1, 1}) {
+        std::array<int, 3> nb = c;
+        nb[a] += s;
+        if (filled.count(nb)) continue;
+        int b = (a + 1) % 3, cc = (a + 2) % 3;
+        if (s < 0) std::swap(b, cc);  // e_b × e_c points outwards
+        for (int u = 0; u < k; ++u)
+          for (int w = 0; w < k; ++w) {
+            auto at = [&](int du, int dw) {
+              std::array<int, 3> q{c[0] * k, c[1] * k, c[2] * k};
+              q[a] += (s > 0 ? k : 0);
+              q[b] += u + du;
+              q[cc] += w + dw;
+              return vertex(q);
+            };
+            add_quad(mesh, at(0, 0), at(1, 0), at(1, 1), at(0, 1), (u + w) % 2 == 1);
+          }
+      }
+    }
+  }
+  // Nodes: lattice points on the surface; arcs: voxel edges on the surface.
+  std::map<std::array<int, 3>, int> node_of;
+  for (const auto& [q, v] : index) {
+    if (q[0] % k || q[1] % k || q[2] % k) continue;
+    const int id = static_cast<int>(out.layout.nodes.size());
+    out.layout.nodes.push_back(make_node(id, v));
+    node_of[q] = id;
+  }
+  for (const auto& [q, id] : node_of) {
+    for (int axis = 0; axis < 3; ++axis) {
+      std::array<int, 3> end = q;
+      end[axis] += k;
+      if (!node_of.count(end)) continue;
+      std::vector<int> path;
+      bool on_surface = true;
+      for (int t = 0; t <= k && on_surface; ++t) {
+        std::array<int, 3> p = q;
+        p[axis] += t;
+        auto it = index.find(p);
+        if (it == index.end())
+          on_surface = false;
+        else
+          path.push_back(it->second);
+      }
+      if (!on_surface) continue;
+      // The lattice edge must be a mesh edge chain (it is unless it cuts through a face).
+      bool chain = true;
+      for (size_t i = 0; i + 1 < path.size(); ++i)
+        chain &= mesh.find_halfedge(mesh.vertex_handle(path[i]), mesh.vertex_handle(path[i + 1]))
+                     .is_valid();
+      // Edges inside a flat face region (both sides coplanar) are lattice lines too: keep them,
+      // they separate voxel faces.
+      if (!chain) continue;
+      out.layout.arcs.push_back(
+          make_arc(static_cast<int>(out.layout.arcs.size()), id, node_of.at(end), path));
+    }
+  }
+  return out;
+}
+
+MeshAndLayout genus2_polycube(int k) {
+  std::vector<std::array<int, 3>> voxels;
+  for (int x = 0; x < 5; ++x)
+    for (int y = 0; y < 3; ++y)
+      if (!(y == 1 && (x == 1 || x == 3))) voxels.push_back({x, y, 0});
+  return voxel_surface(voxels, k);
+}
+
+void write_obj(const TriMesh& mesh, const std::string& path) {
+  std::ofstream out(path);
+  out.precision(17);
+  for (auto v : mesh.vertices()) {
+    const auto& p = mesh.point(v);
+    out << "v " << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
+  }
+  for (auto f : mesh.faces()) {
+    out << 'f';
+    for (auto v : mesh.fv_range(f)) out << ' ' << v.idx() + 1;
+    out << '\n';
+  }
+}
+
+}  // namespace qs::test

@@ -1,0 +1,56 @@
+// Synthetic meshes and layouts for tests (algorithm.md §10), plus paths to test data.
+#pragma once
+
+#include <string>
+
+#include "core/layout/layout.h"
+#include "core/mesh/mesh.h"
+
+namespace qs::test {
+
+//! Folder with the shared real meshes (../shared/data/meshes), or "" when it is absent.
+std::string shared_meshes_dir();
+//! The repository's assets/ folder.
+std::string assets_dir();
+//! Path of the quadsketch-cli executable.
+std::string cli_path();
+//! A fresh empty temporary folder for one test (under the system temp dir).
+std::string temp_dir(const std::string& name);
+
+//! Runs a shell command, returns its exit code and captures stdout+stderr into \p output.
+int run_command(const std::string& command, std::string* output = nullptr);
+
+struct MeshAndLayout {
+  TriMesh mesh;
+  Layout layout;
+};
+
+//! Cube split k×k per face (alternating diagonals), projected onto an ellipsoid with the given
+//! radii (radii {1,1,1}: unit sphere; project=false keeps the cube [-1,1]^3). Layout: the 8
+//! cube corners (valence 3) and the 12 cube edges (each a path of k mesh edges): 6 patches.
+MeshAndLayout cube_sphere(int k, Vec3 radii = Vec3(1, 1, 1), bool project = true);
+
+//! Torus (radii R, r) with an nu×nv quad grid (split into triangles). Layout: a pu×pv grid of
+//! valence-4 nodes with arcs along grid lines (nu % pu == 0, nv % pv == 0). Genus 1, no
+//! singularities.
+MeshAndLayout torus_grid(int nu, int nv, int pu, int pv, double R = 2.0, double r = 0.7);
+
+//! Flat rectangle [0,nx]×[0,ny] (unit grid, triangulated) with a boundary-aligned px×py patch
+//! layout: nodes at grid points (i % (nx/px) == 0 and j % (ny/py) == 0), including boundary
+//! corners, arcs along grid lines including the boundary.
+MeshAndLayout disk_grid(int nx, int ny, int px, int py);
+
+//! Boundary surface of a union of unit voxels (x, y, z integer cells), each voxel face split
+//! k×k and triangulated. Layout: nodes at every lattice point of the voxel grid on the
+//! surface, arcs along every voxel edge on the surface (one patch per voxel face). Sharp 90°
+//! edges everywhere along the arcs; flat patches. The voxel set must give a manifold surface.
+MeshAndLayout voxel_surface(const std::vector<std::array<int, 3>>& voxels, int k);
+
+//! The genus-2 polycube of algorithm.md §10: a 5×3×1 voxel block minus two separated
+//! columns (nodes of valence 3, 4 and 5).
+MeshAndLayout genus2_polycube(int k);
+
+//! Writes a mesh as OBJ text (full precision) — for fixtures only.
+void write_obj(const TriMesh& mesh, const std::string& path);
+
+}  // namespace qs::test

@@ -1,0 +1,264 @@
+// Worker: commands in, ordered snapshots out; cancellation; pins; failures; shutdown.
+// Uses fake step functions (no pipeline stages needed).
+#include "core/pipeline/worker.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <thread>
+
+#include "core/base/errors.h"
+
+namespace qs {
+namespace {
+
+using namespace std::chrono_literals;
+
+std::shared_ptr<const TriMesh> tetrahedron() {
+  auto mesh = std::make_shared<TriMesh>();
+  TriMesh::VertexHandle v[4] = {mesh->add_vertex({0, 0, 0}), mesh->add_vertex({1, 0, 0}),
+                                mesh->add_vertex({0, 1, 0}), mesh->add_vertex({0, 0, 1})};
+  mesh->add_face(v[0], v[2], v[1]);
+  mesh->add_face(v[0], v[1], v[3]);
+  mesh->add_face(v[0], v[3], v[2]);
+  mesh->add_face(v[1], v[2], v[3]);
+  return mesh;
+}
+
+bool is(const Snapshot& s, WorkerStatus status) {
+  return s.status == status;
+}
+
+TEST(Worker, StartsWithAnEmptySnapshot) {
+  Worker worker([](WorkerState&, const WorkerObserver&) { return StepResult{}; });
+  const auto s = worker.latest();
+  ASSERT_TRUE(s);
+  EXPECT_EQ(s->version, 0u);
+  EXPECT_EQ(s->status, WorkerStatus::Idle);
+}
+
+TEST(Worker, RunPublishesOrderedSnapshotsUntilFinished) {
+  Worker worker([](WorkerState& state, const WorkerObserver&) {
+    StepResult r;
+    r.energy = 100.0 - state.iteration;  // iteration is the number of steps done before
+    r.validate = false;
+    return r;
+  });
+  WorkerOptions options;
+  options.max_steps = 6;
+  options.publish_interval_ms = 0;  // publish every step
+  worker.send(cmd::SetOptions{options});
+  worker.send(cmd::LoadMesh{tetrahedron(), Layout{}});
+  const auto run_seq = worker.send(cmd::Run{});
+
+  // Watch the stream: versions strictly increase, iterations never go back.
+  std::uint64_t last_version = 0;
+  int last_iteration = -1;
+  SnapshotPtr s;
+  const auto deadline = std::chrono::steady_clock::now() + 10s;
+  do {
+    s = worker.latest();
+    EXPECT_GE(s->version, last_version);
+    if (s->generation == worker.latest()->generation) EXPECT_GE(s->iteration, last_iteration);
+    last_version = s->version;
+    last_iteration = s->iteration;
+    std::this_thread::yield();
+  } while (!is(*s, WorkerStatus::Finished) && std::chrono::steady_clock::now() < deadline);
+
+  ASSERT_EQ(s->status, WorkerStatus::Finished);
+  EXPECT_EQ(s->iteration, 6);
+  ASSERT_EQ(s->energy_history.size(), 6u);
+  for (int i = 0; i < 6; ++i) EXPECT_DOUBLE_EQ(s->energy_history[i], 100.0 - i);
+  EXPECT_DOUBLE_EQ(s->energy, 95.0);
+  EXPECT_GE(s->applied_seq, run_seq);
+  EXPECT_TRUE(s->mesh);
+  EXPECT_TRUE(s->layout);
+}
+
+TEST(Worker, StopCancelsARunningStepAndTheWorkerStaysUsable) {
+  std::atomic<bool> slow{true};
+  std::atomic<int> entered{0};
+  Worker worker([&](WorkerState&, const WorkerObserver& observer) {
+    ++entered;
+    while (slow) {
+      observer.check_cancel();  // throws Cancelled once Stop bumped the generation
+      std::this_thread::sleep_for(1ms);
+    }
+    StepResult r;
+    r.finished = true;
+    r.message = "done";
+    r.validate = false;
+    return r;
+  });
+  worker.send(cmd::LoadMesh{tetrahedron(), Layout{}});
+  worker.send(cmd::Run{});
+  for (int i = 0; i < 5000 && entered == 0; ++i) std::this_thread::sleep_for(1ms);
+  ASSERT_GT(entered.load(), 0);
+
+  const auto stop_seq = worker.send(cmd::Stop{});
+  auto s = worker.wait_for(
+      [&](const Snapshot& x) {
+        return x.applied_seq >= stop_seq && is(x, WorkerStatus::Cancelled);
+      },
+      5s);
+  EXPECT_EQ(s->status, WorkerStatus::Cancelled);
+  EXPECT_EQ(s->iteration, 0);
+
+  slow = false;
+  worker.send(cmd::Run{});
+  s = worker.wait_for([](const Snapshot& x) { return is(x, WorkerStatus::Finished); }, 5s);
+  EXPECT_EQ(s->status, WorkerStatus::Finished);
+  EXPECT_EQ(s->message, "done");
+}
+
+TEST(Worker, PinsAreAppliedAtTheNextStep) {
+  std::mutex seen_mutex;
+  std::map<int, int> seen_pins;
+  Worker worker([&](WorkerState& state, const WorkerObserver&) {
+    std::lock_guard lock(seen_mutex);
+    seen_pins = state.pins;
+    StepResult r;
+    r.validate = false;
+    return r;
+  });
+  worker.send(cmd::LoadMesh{tetrahedron(), Layout{}});
+  const auto pin_seq = worker.send(cmd::SetPin{7, 3});
+  // The pin is drained but not applied: no step ran, so applied_seq stays below it.
+  auto s = worker.wait_for([](const Snapshot& x) { return x.version >= 2; }, 2s);
+  std::this_thread::sleep_for(20ms);
+  s = worker.latest();
+  EXPECT_LT(s->applied_seq, pin_seq);
+  EXPECT_TRUE(s->pins.empty());
+
+  worker.send(cmd::Step{});
+  s = worker.wait_for([&](const Snapshot& x) { return x.iteration >= 1; }, 5s);
+  ASSERT_EQ(s->iteration, 1);
+  EXPECT_GE(s->applied_seq, pin_seq);
+  ASSERT_EQ(s->pins.size(), 1u);
+  EXPECT_EQ(s->pins[0][0], 7);
+  EXPECT_EQ(s->pins[0][1], 3);
+  {
+    std::lock_guard lock(seen_mutex);
+    EXPECT_EQ(seen_pins.at(7), 3);
+  }
+
+  const auto clear_seq = worker.send(cmd::ClearPin{7});
+  worker.send(cmd::Step{});
+  s = worker.wait_for([&](const Snapshot& x) { return x.iteration >= 2; }, 5s);
+  EXPECT_GE(s->applied_seq, clear_seq);
+  EXPECT_TRUE(s->pins.empty());
+}
+
+TEST(Worker, RepeatedSetPinForOneNodeCollapses) {
+  std::atomic<bool> gate{false};
+  std::atomic<int> entered{0};
+  Worker worker([&](WorkerState& state, const WorkerObserver&) {
+    ++entered;
+    while (!gate) std::this_thread::sleep_for(1ms);  // hold the worker inside a step
+    StepResult r;
+    r.validate = false;
+    r.message = "pins " + std::to_string(state.pins.size());
+    return r;
+  });
+  worker.send(cmd::LoadMesh{tetrahedron(), Layout{}});
+  worker.send(cmd::Step{});
+  for (int i = 0; i < 5000 && entered == 0; ++i) std::this_thread::sleep_for(1ms);
+  ASSERT_EQ(entered.load(), 1);
+
+  // The worker is busy: these stay queued, and the three SetPin for node 1 collapse.
+  worker.send(cmd::SetPin{1, 0});
+  worker.send(cmd::SetPin{2, 0});
+  worker.send(cmd::SetPin{1, 2});
+  const auto last = worker.send(cmd::SetPin{1, 3});
+  EXPECT_EQ(worker.queued(), 2u);
+
+  worker.send(cmd::Step{});
+  gate = true;
+  auto s = worker.wait_for([&](const Snapshot& x) { return x.applied_seq >= last; }, 5s);
+  ASSERT_GE(s->applied_seq, last);
+  ASSERT_EQ(s->pins.size(), 2u);
+  EXPECT_EQ(s->pins[0][0], 1);
+  EXPECT_EQ(s->pins[0][1], 3);  // the latest wins
+}
+
+TEST(Worker, FailuresArePublishedAndTheWorkerStaysAlive) {
+  Worker worker([](WorkerState&, const WorkerObserver&) -> StepResult {
+    throw SolverError("parameterization: matrix not positive definite (n = 12)");
+  });
+  worker.send(cmd::LoadMesh{tetrahedron(), Layout{}});
+  worker.send(cmd::Run{});
+  auto s = worker.wait_for([](const Snapshot& x) { return is(x, WorkerStatus::Failed); }, 5s);
+  ASSERT_EQ(s->status, WorkerStatus::Failed);
+  EXPECT_NE(s->message.find("positive definite"), std::string::npos);
+
+  const auto seq = worker.send(cmd::LoadMesh{tetrahedron(), Layout{}});
+  s = worker.wait_for([&](const Snapshot& x) { return x.applied_seq >= seq; }, 5s);
+  EXPECT_EQ(s->status, WorkerStatus::Idle);
+}
+
+TEST(Worker, RunWithoutMeshFails) {
+  Worker worker([](WorkerState&, const WorkerObserver&) { return StepResult{}; });
+  worker.send(cmd::Run{});
+  auto s = worker.wait_for([](const Snapshot& x) { return is(x, WorkerStatus::Failed); }, 5s);
+  EXPECT_EQ(s->status, WorkerStatus::Failed);
+  EXPECT_EQ(s->message, "no mesh loaded");
+}
+
+TEST(Worker, PauseAndStep) {
+  std::atomic<bool> gate{true};
+  Worker worker([&](WorkerState&, const WorkerObserver& observer) {
+    while (!gate) {
+      observer.check_cancel();
+      std::this_thread::sleep_for(1ms);
+    }
+    std::this_thread::sleep_for(2ms);
+    StepResult r;
+    r.validate = false;
+    return r;
+  });
+  WorkerOptions options;
+  options.max_steps = 1000000;
+  worker.send(cmd::SetOptions{options});
+  worker.send(cmd::LoadMesh{tetrahedron(), Layout{}});
+  worker.send(cmd::Run{});
+  worker.wait_for([](const Snapshot& x) { return x.iteration >= 3; }, 5s);
+  const auto pause_seq = worker.send(cmd::Pause{});
+  auto s = worker.wait_for(
+      [&](const Snapshot& x) { return x.applied_seq >= pause_seq && is(x, WorkerStatus::Paused); },
+      5s);
+  ASSERT_EQ(s->status, WorkerStatus::Paused);
+  const int paused_at = s->iteration;
+  std::this_thread::sleep_for(30ms);
+  EXPECT_EQ(worker.latest()->iteration, paused_at);  // nothing runs while paused
+
+  worker.send(cmd::Step{2});
+  s = worker.wait_for([&](const Snapshot& x) { return x.iteration >= paused_at + 2; }, 5s);
+  EXPECT_EQ(s->iteration, paused_at + 2);
+  std::this_thread::sleep_for(30ms);
+  EXPECT_EQ(worker.latest()->iteration, paused_at + 2);
+  EXPECT_EQ(worker.latest()->status, WorkerStatus::Paused);
+}
+
+TEST(Worker, ShutsDownCleanlyDuringALongStep) {
+  std::atomic<int> entered{0};
+  const auto start = std::chrono::steady_clock::now();
+  {
+    Worker worker([&](WorkerState&, const WorkerObserver& observer) {
+      ++entered;
+      for (;;) {  // only cancellation ends this step
+        observer.check_cancel();
+        std::this_thread::sleep_for(1ms);
+      }
+      return StepResult{};
+    });
+    worker.send(cmd::LoadMesh{tetrahedron(), Layout{}});
+    worker.send(cmd::Run{});
+    for (int i = 0; i < 5000 && entered == 0; ++i) std::this_thread::sleep_for(1ms);
+    ASSERT_GT(entered.load(), 0);
+  }  // ~Worker must return promptly
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 5s);
+}
+
+}  // namespace
+}  // namespace qs
