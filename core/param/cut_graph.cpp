@@ -1,0 +1,87 @@
+#include "core/param/cut_graph.h"
+
+#include <deque>
+#include <numeric>
+
+namespace qs {
+
+CutGraph build_cut_graph(const TriMesh& mesh, const GeometryCache& g, const std::vector<int>& p,
+                         const std::vector<char>& singular) {
+  CutGraph cg;
+  const int nf = g.n_faces, ne = g.n_edges;
+  cg.cut.assign(ne, 0);
+  // Spanning tree of faces across identity-transition edges (BFS); every other interior edge
+  // is cut. The period-jump tree of topology.cpp has p = 0, so every face is reached.
+  std::vector<char> seen(nf, 0), tree(ne, 0);
+  for (int root = 0; root < nf; ++root) {
+    if (seen[root]) continue;
+    seen[root] = 1;
+    std::deque<int> queue{root};
+    while (!queue.empty()) {
+      const int f = queue.front();
+      queue.pop_front();
+      for (auto h : mesh.fh_range(mesh.face_handle(f))) {
+        const int e = mesh.edge_handle(h).idx();
+        if (p[e] % 4 != 0) continue;
+        const auto opp = mesh.opposite_halfedge_handle(h);
+        if (mesh.is_boundary(opp)) continue;
+        const int f2 = mesh.face_handle(opp).idx();
+        if (seen[f2]) continue;
+        seen[f2] = 1;
+        tree[e] = 1;
+        queue.push_back(f2);
+      }
+    }
+  }
+  std::vector<int> valence(g.n_vertices, 0);
+  for (int e = 0; e < ne; ++e) {
+    if (g.edge_face_i[e] < 0 || g.edge_face_j[e] < 0 || tree[e]) continue;
+    cg.cut[e] = 1;
+    ++valence[g.edge_vertices[e][0]];
+    ++valence[g.edge_vertices[e][1]];
+  }
+  // Retract dangling branches.
+  std::vector<int> stack;
+  for (int v = 0; v < g.n_vertices; ++v)
+    if (valence[v] == 1 && !singular[v]) stack.push_back(v);
+  while (!stack.empty()) {
+    const int v = stack.back();
+    stack.pop_back();
+    if (valence[v] != 1 || singular[v]) continue;
+    for (auto h : mesh.voh_range(mesh.vertex_handle(v))) {
+      const int e = mesh.edge_handle(h).idx();
+      if (!cg.cut[e]) continue;
+      if (p[e] % 4 != 0) break;  // a rotation seam stays
+      cg.cut[e] = 0;
+      --valence[v];
+      const int w = mesh.to_vertex_handle(h).idx();
+      if (--valence[w] == 1 && !singular[w]) stack.push_back(w);
+      break;
+    }
+  }
+  for (int e = 0; e < ne; ++e) cg.cut_edges += cg.cut[e];
+
+  // Wedges: union-find of corners across non-cut interior edges.
+  std::vector<int> parent(3 * nf);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (int e = 0; e < ne; ++e) {
+    const int i = g.edge_face_i[e], j = g.edge_face_j[e];
+    if (i < 0 || j < 0 || cg.cut[e]) continue;
+    for (int v : g.edge_vertices[e])
+      parent[find(3 * i + corner_of(g, i, v))] = find(3 * j + corner_of(g, j, v));
+  }
+  cg.corner_wedge.assign(3 * nf, -1);
+  std::vector<int> id(3 * nf, -1);
+  for (int c = 0; c < 3 * nf; ++c) {
+    const int r = find(c);
+    if (id[r] < 0) id[r] = cg.wedges++;
+    cg.corner_wedge[c] = id[r];
+  }
+  return cg;
+}
+
+}  // namespace qs

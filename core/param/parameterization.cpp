@@ -1,0 +1,326 @@
+#include "core/param/parameterization.h"
+
+#include <Eigen/Dense>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "core/base/errors.h"
+
+namespace qs {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+using Terms = std::vector<std::pair<int, double>>;
+
+// A pair of affine expressions (u, v) in the unknowns.
+struct Lin2 {
+  Terms u, v;
+  double cu = 0, cv = 0;
+};
+
+Lin2 corner_expr(const GeometryCache& g, const CutGraph& cut, int f, int vertex) {
+  const int w = cut.corner_wedge[3 * f + corner_of(g, f, vertex)];
+  Lin2 e;
+  e.u.push_back({2 * w, 1.0});
+  e.v.push_back({2 * w + 1, 1.0});
+  return e;
+}
+
+Terms scaled(const Terms& t, double s) {
+  Terms out = t;
+  for (auto& [v, c] : out) c *= s;
+  return out;
+}
+
+void append(Terms& a, const Terms& b, double s = 1.0) {
+  for (auto [v, c] : b) a.push_back({v, s * c});
+}
+
+Lin2 sub(const Lin2& a, const Lin2& b) {
+  Lin2 r = a;
+  append(r.u, b.u, -1.0);
+  append(r.v, b.v, -1.0);
+  r.cu -= b.cu;
+  r.cv -= b.cv;
+  return r;
+}
+
+Lin2 add(const Lin2& a, const Lin2& b) {
+  Lin2 r = a;
+  append(r.u, b.u);
+  append(r.v, b.v);
+  r.cu += b.cu;
+  r.cv += b.cv;
+  return r;
+}
+
+Lin2 rotate(int r, const Lin2& a) {
+  switch (((r % 4) + 4) % 4) {
+    case 1:
+      return {scaled(a.v, -1.0), a.u, -a.cv, a.cu};
+    case 2:
+      return {scaled(a.u, -1.0), scaled(a.v, -1.0), -a.cu, -a.cv};
+    case 3:
+      return {a.v, scaled(a.u, -1.0), a.cv, -a.cu};
+    default:
+      return a;
+  }
+}
+
+// Merges duplicate variables so expressions stay short along long arcs.
+void compact(Terms& t) {
+  std::sort(t.begin(), t.end());
+  Terms out;
+  for (auto [v, c] : t) {
+    if (!out.empty() && out.back().first == v)
+      out.back().second += c;
+    else
+      out.push_back({v, c});
+  }
+  out.erase(
+      std::remove_if(out.begin(), out.end(), [](auto& p) { return std::abs(p.second) < 1e-15; }),
+      out.end());
+  t.swap(out);
+}
+
+// Local 2D gradient operator of face f: ∇φ_k (2D, in the frame r_f, n×r_f), and the area.
+void face_gradients(const TriMesh& mesh, const GeometryCache& g, int f,
+                    Eigen::Matrix<double, 2, 3>& G, double& area) {
+  const auto& fv = g.face_vertices[f];
+  const Vec3& r = g.face_frame[f];
+  const Vec3 s = g.face_normal[f] % r;
+  const Vec3 x0 = mesh.point(mesh.vertex_handle(fv[0]));
+  Eigen::Vector2d p[3];
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 d = mesh.point(mesh.vertex_handle(fv[k])) - x0;
+    p[k] = Eigen::Vector2d(d | r, d | s);
+  }
+  const Eigen::Vector2d e1 = p[1] - p[0], e2 = p[2] - p[0];
+  const double a2 = e1.x() * e2.y() - e1.y() * e2.x();  // 2A
+  area = 0.5 * a2;
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector2d e = p[(k + 2) % 3] - p[(k + 1) % 3];
+    G.col(k) = Eigen::Vector2d(-e.y(), e.x()) / a2;
+  }
+}
+
+}  // namespace
+
+double param_signed_area2(const std::vector<std::array<double, 2>>& uv, int f) {
+  const auto& a = uv[3 * f];
+  const auto& b = uv[3 * f + 1];
+  const auto& c = uv[3 * f + 2];
+  return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+}
+
+ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layout& layout,
+                         const LayoutTopology& topo, const std::vector<int>& p,
+                         const std::vector<double>& theta, const ParamOptions& options)
+    : options_(options), period_jump_(p) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<char> singular(g.n_vertices, 0);
+  for (int n = 0; n < topo.num_nodes; ++n)
+    if (topo.valence[n] != 4) singular[layout.nodes[n].vertex] = 1;
+  cut_ = build_cut_graph(mesh, g, p, singular);
+  labeling_ = label_layout(mesh, g, layout, topo, p, theta);
+  system_.variables = 2 * cut_.wedges;
+
+  auto add_row = [&](Terms terms, double rhs, int origin) {
+    compact(terms);
+    system_.rows.push_back({std::move(terms), rhs, origin});
+  };
+  auto edge_name = [&](int a, int b) {
+    return "(" + std::to_string(a) + ", " + std::to_string(b) + ")";
+  };
+
+  // Fixed point first (removes the translation null space): the first node at (0, 0).
+  {
+    const int h = topo.node_half_arcs[0].empty() ? 0 : topo.node_half_arcs[0][0];
+    const Lin2 x = corner_expr(g, cut_, labeling_.chart_face[h], layout.nodes[0].vertex);
+    const int o = system_.add_origin("fixed point at node " + std::to_string(layout.nodes[0].id));
+    add_row(x.u, 0.0, o);
+    add_row(x.v, 0.0, o);
+  }
+  // Seams: edge vectors agree up to the rotation across every cut edge.
+  for (int e = 0; e < g.n_edges; ++e) {
+    if (!cut_.cut[e]) continue;
+    const auto [a, b] = g.edge_vertices[e];
+    const int i = g.edge_face_i[e], j = g.edge_face_j[e];
+    const int r = step_rotation(p[e], a, b);
+    const Lin2 vi = sub(corner_expr(g, cut_, i, b), corner_expr(g, cut_, i, a));
+    const Lin2 vj = sub(corner_expr(g, cut_, j, b), corner_expr(g, cut_, j, a));
+    const Lin2 d = sub(vj, rotate(r, vi));
+    const int o = system_.add_origin("seam at edge " + edge_name(a, b));
+    add_row(d.u, 0.0, o);
+    add_row(d.v, 0.0, o);
+  }
+  // Arcs: node connection (3); along boundary and pinned arcs every path vertex is on the
+  // iso-line.
+  for (int a = 0; a < topo.num_arcs; ++a) {
+    const LayoutArc& arc = layout.arcs[a];
+    const ArcStrip& s = labeling_.strips[a];
+    bool along_boundary = true;
+    for (size_t k = 0; k + 1 < arc.path.size(); ++k) {
+      const auto h =
+          mesh.find_halfedge(mesh.vertex_handle(arc.path[k]), mesh.vertex_handle(arc.path[k + 1]));
+      along_boundary &= mesh.is_boundary(mesh.edge_handle(h));
+    }
+    const bool iso_all = arc.pinned || along_boundary;
+    if (arc.dangling() && !iso_all) continue;
+    const int start_half = s.reversed ? 2 * a + 1 : 2 * a;
+    const int d0 = labeling_.symbol[start_half];
+    const int origin =
+        system_.add_origin("arc " + std::to_string(arc.id) +
+                           (iso_all ? " (iso-line along its path)" : " (node connection)"));
+    Lin2 P = corner_expr(g, cut_, labeling_.chart_face[start_half], s.walk[0]);
+    int r_total = 0;
+    size_t step = 0;
+    const size_t K = s.walk.size() - 1;
+    for (size_t k = 1; k <= K; ++k) {
+      for (; step < static_cast<size_t>(s.arrival[k]); ++step) {
+        const auto h = s.steps[step];
+        const int fi = mesh.face_handle(h).idx();
+        const int fj = mesh.face_handle(mesh.opposite_halfedge_handle(h)).idx();
+        const int pivot = mesh.from_vertex_handle(h).idx();
+        const int r =
+            step_rotation(p[mesh.edge_handle(h).idx()], pivot, mesh.to_vertex_handle(h).idx());
+        if (r == 0 && !cut_.cut[mesh.edge_handle(h).idx()]) continue;  // identity, same wedge
+        P = add(rotate(r, sub(P, corner_expr(g, cut_, fi, pivot))),
+                corner_expr(g, cut_, fj, pivot));
+        compact(P.u);
+        compact(P.v);
+        r_total += r;
+      }
+      const bool last = k == K;
+      if (!iso_all && !last) continue;
+      if (last && arc.dangling()) break;
+      const int face = mesh.face_handle(mesh.find_halfedge(mesh.vertex_handle(s.walk[k - 1]),
+                                                           mesh.vertex_handle(s.walk[k])))
+                           .idx();
+      const Lin2 X = corner_expr(g, cut_, face, s.walk[k]);
+      const bool along_u = (d0 + r_total) % 2 == 0;  // the arc runs along ±u here: v constant
+      Terms row = along_u ? P.v : P.u;
+      append(row, along_u ? X.v : X.u, -1.0);
+      add_row(row, along_u ? X.cv - P.cv : X.cu - P.cu, origin);
+    }
+  }
+  // Explicit feature edges (layout "features") that are not arcs: iso-lines of the field's
+  // matching parameter.
+  {
+    std::vector<char> arc_edge(g.n_edges, 0);
+    for (const auto& arc : layout.arcs)
+      for (size_t k = 0; k + 1 < arc.path.size(); ++k)
+        arc_edge[mesh.edge_handle(mesh.find_halfedge(mesh.vertex_handle(arc.path[k]),
+                                                     mesh.vertex_handle(arc.path[k + 1])))
+                     .idx()] = 1;
+    for (const auto& [a, b] : layout.feature_edges) {
+      auto h = mesh.find_halfedge(mesh.vertex_handle(a), mesh.vertex_handle(b));
+      if (!h.is_valid() || arc_edge[mesh.edge_handle(h).idx()]) continue;
+      if (mesh.is_boundary(h)) h = mesh.opposite_halfedge_handle(h);
+      const int f = mesh.face_handle(h).idx();
+      const Vec3 t = mesh.point(mesh.vertex_handle(b)) - mesh.point(mesh.vertex_handle(a));
+      const double rel = g.angle_in_face(f, t) - theta[f];
+      const bool along_u = std::lround(rel / (M_PI / 2)) % 2 == 0;
+      const Lin2 d = sub(corner_expr(g, cut_, f, b), corner_expr(g, cut_, f, a));
+      const int o = system_.add_origin("feature edge " + edge_name(a, b));
+      add_row(along_u ? d.v : d.u, 0.0, o);
+    }
+  }
+  reduction_ = eliminate_constraints(system_);
+  result_.wedges = cut_.wedges;
+  result_.cut_edges = cut_.cut_edges;
+  result_.constraint_rows = static_cast<int>(system_.rows.size());
+  result_.eliminated = reduction_.eliminated;
+  result_.redundant = reduction_.redundant;
+  result_.unknowns = static_cast<int>(reduction_.Z.cols());
+  result_.timings.setup_s = seconds_since(t0);
+  solve(mesh, g, theta);
+}
+
+ParamSolver::~ParamSolver() = default;
+
+const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCache& g,
+                                           const std::vector<double>& theta) {
+  auto t0 = std::chrono::steady_clock::now();
+  const int n = system_.variables;
+  const double aniso = options_.anisotropic ? options_.anisotropy : 1.0;
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(18 * g.n_faces);
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
+  double constant = 0;
+  for (int f = 0; f < g.n_faces; ++f) {
+    Eigen::Matrix<double, 2, 3> G;
+    double area;
+    face_gradients(mesh, g, f, G, area);
+    const Eigen::Vector2d u(std::cos(theta[f]), std::sin(theta[f])), v(-u.y(), u.x());
+    const Eigen::Matrix2d Wu = u * u.transpose() + aniso * v * v.transpose();
+    const Eigen::Matrix2d Wv = v * v.transpose() + aniso * u * u.transpose();
+    const Eigen::Matrix3d Hu = area * G.transpose() * Wu * G;
+    const Eigen::Matrix3d Hv = area * G.transpose() * Wv * G;
+    const Eigen::Vector3d gu = area * G.transpose() * u, gv = area * G.transpose() * v;
+    int w[3];
+    for (int k = 0; k < 3; ++k) w[k] = cut_.corner_wedge[3 * f + k];
+    for (int k = 0; k < 3; ++k) {
+      rhs(2 * w[k]) += gu(k);
+      rhs(2 * w[k] + 1) += gv(k);
+      for (int l = 0; l < 3; ++l) {
+        triplets.emplace_back(2 * w[k], 2 * w[l], Hu(k, l));
+        triplets.emplace_back(2 * w[k] + 1, 2 * w[l] + 1, Hv(k, l));
+      }
+    }
+    constant += 2 * area;
+  }
+  Eigen::SparseMatrix<double> H(n, n);
+  H.setFromTriplets(triplets.begin(), triplets.end());
+  const Eigen::SparseMatrix<double>& Z = reduction_.Z;
+  const Eigen::SparseMatrix<double> A = (Z.transpose() * H * Z).eval();
+  const Eigen::VectorXd b = Z.transpose() * (rhs - H * reduction_.z0);
+  result_.timings.assemble_s = seconds_since(t0);
+  t0 = std::chrono::steady_clock::now();
+  solver_.factorize(A);
+  result_.timings.factorize_s = solver_.stats().factorize_s;
+  result_.timings.analyze_s = solver_.stats().analyze_s;
+  t0 = std::chrono::steady_clock::now();
+  const Eigen::VectorXd y = solver_.solve(b);
+  const Eigen::VectorXd x = Z * y + reduction_.z0;
+  result_.energy = std::max(0.0, x.dot(H * x) - 2 * rhs.dot(x) + constant);
+  result_.corner_uv.resize(3 * g.n_faces);
+  result_.foldovers = 0;
+  for (int f = 0; f < g.n_faces; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const int w = cut_.corner_wedge[3 * f + k];
+      result_.corner_uv[3 * f + k] = {x(2 * w), x(2 * w + 1)};
+    }
+    result_.foldovers += param_signed_area2(result_.corner_uv, f) <= 0;
+  }
+  result_.timings.solve_s = seconds_since(t0);
+  return result_;
+}
+
+std::vector<double> face_energies(const TriMesh& mesh, const GeometryCache& g,
+                                  const std::vector<double>& theta,
+                                  const std::vector<std::array<double, 2>>& uv,
+                                  const ParamOptions& options) {
+  const double aniso = options.anisotropic ? options.anisotropy : 1.0;
+  std::vector<double> out(g.n_faces);
+  for (int f = 0; f < g.n_faces; ++f) {
+    Eigen::Matrix<double, 2, 3> G;
+    double area;
+    face_gradients(mesh, g, f, G, area);
+    const Eigen::Vector2d u(std::cos(theta[f]), std::sin(theta[f])), v(-u.y(), u.x());
+    const Eigen::Vector3d cu(uv[3 * f][0], uv[3 * f + 1][0], uv[3 * f + 2][0]);
+    const Eigen::Vector3d cv(uv[3 * f][1], uv[3 * f + 1][1], uv[3 * f + 2][1]);
+    const Eigen::Vector2d ru = G * cu - u, rv = G * cv - v;
+    const Eigen::Matrix2d Wu = u * u.transpose() + aniso * v * v.transpose();
+    const Eigen::Matrix2d Wv = v * v.transpose() + aniso * u * u.transpose();
+    out[f] = area * (ru.dot(Wu * ru) + rv.dot(Wv * rv));
+  }
+  return out;
+}
+
+}  // namespace qs

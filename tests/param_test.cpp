@@ -1,0 +1,102 @@
+// Seamless parameterization with layout constraints (issue #4).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/field/cross_field.h"
+#include "core/layout/validate.h"
+#include "core/mesh/geometry.h"
+#include "core/param/parameterization.h"
+#include "tests/fixtures.h"
+
+namespace qs {
+namespace {
+
+struct Solved {
+  GeometryCache geometry;
+  LayoutTopology topology;
+  CrossField field;
+  std::unique_ptr<ParamSolver> param;
+};
+
+Solved solve_all(const test::MeshAndLayout& in, ParamOptions opt = {}) {
+  const auto v = validate_layout(in.mesh, in.layout);
+  for (const auto& i : v.issues) ADD_FAILURE() << format_issue(i);
+  Solved s;
+  s.geometry = build_geometry(in.mesh);
+  s.topology = build_topology(in.mesh, in.layout);
+  s.field = compute_cross_field(in.mesh, s.geometry, in.layout, s.topology);
+  s.param = std::make_unique<ParamSolver>(in.mesh, s.geometry, in.layout, s.topology,
+                                          s.field.period_jump, s.field.theta, opt);
+  return s;
+}
+
+// Across every interior edge, the edge vectors of the two faces agree up to the rotation
+// −p mod 4 (seamless), and the rotation recovered from the corner values equals −p mod 4.
+void expect_seamless(const test::MeshAndLayout& in, const Solved& s) {
+  const auto& uv = s.param->result().corner_uv;
+  const GeometryCache& g = s.geometry;
+  double worst = 0, scale = 0;
+  int wrong_rotation = 0;
+  for (int e = 0; e < g.n_edges; ++e) {
+    const int i = g.edge_face_i[e], j = g.edge_face_j[e];
+    if (i < 0 || j < 0) continue;
+    const auto [a, b] = g.edge_vertices[e];
+    const auto& ia = uv[3 * i + corner_of(g, i, a)];
+    const auto& ib = uv[3 * i + corner_of(g, i, b)];
+    const auto& ja = uv[3 * j + corner_of(g, j, a)];
+    const auto& jb = uv[3 * j + corner_of(g, j, b)];
+    const std::array<double, 2> di{ib[0] - ia[0], ib[1] - ia[1]}, dj{jb[0] - ja[0], jb[1] - ja[1]};
+    const int r = step_rotation(s.field.period_jump[e], a, b);
+    const auto rd = rotate(r, di);
+    worst = std::max(worst, std::hypot(dj[0] - rd[0], dj[1] - rd[1]));
+    scale = std::max(scale, std::hypot(di[0], di[1]));
+    // Recover the rotation from the corner values (libQEx style).
+    const double ang = std::atan2(dj[1], dj[0]) - std::atan2(di[1], di[0]);
+    const int rec = ((static_cast<int>(std::lround(ang / (M_PI / 2))) % 4) + 4) % 4;
+    wrong_rotation += rec != r;
+  }
+  EXPECT_LT(worst, 1e-8 * scale) << "edge vectors disagree across a seam";
+  EXPECT_EQ(wrong_rotation, 0);
+  (void)in;
+}
+
+TEST(Parameterization, CubeOnSphereIsSeamlessAndFoldFree) {
+  const auto in = test::cube_sphere(8);
+  const Solved s = solve_all(in);
+  const auto& r = s.param->result();
+  expect_seamless(in, s);
+  EXPECT_EQ(r.foldovers, 0);
+  EXPECT_GT(r.energy, 0);
+  EXPECT_EQ(s.param->labeling().geometric_mismatches, 0);
+  EXPECT_GT(r.redundant, 0) << "node rows implied by the others must be detected";
+}
+
+TEST(Parameterization, TorusGridIsSeamless) {
+  const auto in = test::torus_grid(32, 16, 4, 2);
+  const Solved s = solve_all(in);
+  expect_seamless(in, s);
+  EXPECT_EQ(s.param->result().foldovers, 0);
+}
+
+TEST(Parameterization, FlatPolycubeIsIsometric) {
+  const auto in = test::genus2_polycube(3);
+  const Solved s = solve_all(in);
+  expect_seamless(in, s);
+  const auto& r = s.param->result();
+  EXPECT_EQ(r.foldovers, 0);
+  double area = 0;
+  for (double a : s.geometry.face_area) area += a;
+  EXPECT_LT(r.energy, 1e-10 * area);
+}
+
+TEST(Parameterization, FlatDiskGridIsIsometric) {
+  const auto in = test::disk_grid(12, 8, 3, 2);
+  const Solved s = solve_all(in);
+  const auto& r = s.param->result();
+  EXPECT_EQ(r.foldovers, 0);
+  EXPECT_LT(r.energy, 1e-10 * 96);
+}
+
+}  // namespace
+}  // namespace qs
