@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "core/extract/tracing.h"
 #include "core/field/cross_field.h"
 #include "core/layout/validate.h"
 #include "core/mesh/geometry.h"
@@ -61,6 +62,41 @@ void expect_seamless(const test::MeshAndLayout& in, const Solved& s) {
   (void)in;
 }
 
+// Traces every arc and checks the embedding: all arcs reach their end nodes, no crossings,
+// consecutive samples in one face differ in one parameter only, and opposite patch sides
+// have equal parametric length.
+Extraction expect_valid_embedding(const test::MeshAndLayout& in, const Solved& s) {
+  const auto& uv = s.param->result().corner_uv;
+  const Extraction ex = extract_layout(in.mesh, s.geometry, in.layout, s.topology,
+                                       s.param->labeling(), s.field.period_jump, uv);
+  for (const auto& p : ex.problems) ADD_FAILURE() << p;
+  EXPECT_TRUE(ex.structurally_equivalent);
+  EXPECT_EQ(ex.patch_size.size(), s.topology.patches.size());
+  double worst = 0;
+  for (size_t a = 0; a < ex.arcs.size(); ++a) {
+    const auto& t = ex.arcs[a];
+    for (size_t i = 0; i + 1 < t.samples.size(); ++i) {
+      const int f = t.samples[i + 1].face;
+      const auto p0 = uv_in_face(in.mesh, s.geometry, uv, t.samples[i], f);
+      const auto p1 = uv_in_face(in.mesh, s.geometry, uv, t.samples[i + 1], f);
+      const double du = std::abs(p1[0] - p0[0]), dv = std::abs(p1[1] - p0[1]);
+      const double moving = std::max(du, dv), fixed = std::min(du, dv);
+      if (moving > 1e-12) worst = std::max(worst, fixed / moving);
+    }
+  }
+  EXPECT_LT(worst, 1e-6) << "iso-line violation";
+  for (const auto& P : s.topology.patches) {
+    if (P.darts.size() != 4) continue;
+    const double l0 = ex.arcs[P.darts[0] >> 1].param_length,
+                 l2 = ex.arcs[P.darts[2] >> 1].param_length;
+    const double l1 = ex.arcs[P.darts[1] >> 1].param_length,
+                 l3 = ex.arcs[P.darts[3] >> 1].param_length;
+    EXPECT_NEAR(l0, l2, 1e-6 * std::max(l0, l2));
+    EXPECT_NEAR(l1, l3, 1e-6 * std::max(l1, l3));
+  }
+  return ex;
+}
+
 TEST(Parameterization, CubeOnSphereIsSeamlessAndFoldFree) {
   const auto in = test::cube_sphere(8);
   const Solved s = solve_all(in);
@@ -70,6 +106,7 @@ TEST(Parameterization, CubeOnSphereIsSeamlessAndFoldFree) {
   EXPECT_GT(r.energy, 0);
   EXPECT_EQ(s.param->labeling().geometric_mismatches, 0);
   EXPECT_GT(r.redundant, 0) << "node rows implied by the others must be detected";
+  expect_valid_embedding(in, s);
 }
 
 TEST(Parameterization, TorusGridIsSeamless) {
@@ -77,6 +114,7 @@ TEST(Parameterization, TorusGridIsSeamless) {
   const Solved s = solve_all(in);
   expect_seamless(in, s);
   EXPECT_EQ(s.param->result().foldovers, 0);
+  expect_valid_embedding(in, s);
 }
 
 TEST(Parameterization, FlatPolycubeIsIsometric) {
@@ -88,6 +126,7 @@ TEST(Parameterization, FlatPolycubeIsIsometric) {
   double area = 0;
   for (double a : s.geometry.face_area) area += a;
   EXPECT_LT(r.energy, 1e-10 * area);
+  expect_valid_embedding(in, s);
 }
 
 TEST(Parameterization, FlatDiskGridIsIsometric) {
@@ -96,6 +135,7 @@ TEST(Parameterization, FlatDiskGridIsIsometric) {
   const auto& r = s.param->result();
   EXPECT_EQ(r.foldovers, 0);
   EXPECT_LT(r.energy, 1e-10 * 96);
+  expect_valid_embedding(in, s);
 }
 
 }  // namespace

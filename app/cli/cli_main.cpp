@@ -57,6 +57,12 @@ int main(int argc, char** argv) {
   cmd_import->add_option("--quads", imp.quads, "Quad mesh")->required();
   cmd_import->add_option("--onto", imp.onto, "Triangle mesh to transfer the layout onto");
   cmd_import->add_option("--out", imp.out, "Output folder")->required();
+  cmd_import->add_flag("--all-edges", imp.all_edges,
+                       "Use every edge as an arc (coarse cages) instead of the base complex");
+  cmd_import
+      ->add_option("--refine", imp.refine, "Split each quad K x K before triangulating (no --onto)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
 
   PerturbOptions perturb;
   auto* cmd_perturb = app.add_subcommand("perturb", "Move the nodes of a layout randomly");

@@ -5,6 +5,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "app/cli/report.h"
 #include "core/base/atomic_file.h"
 #include "core/base/errors.h"
 #include "core/layout/layout_io.h"
@@ -20,13 +21,6 @@ int not_implemented(const std::string& command, const std::string& issue) {
   std::cerr << "error: quadsketch-cli " << command << " is not implemented yet (tracked in issue "
             << issue << ")\n";
   return 1;
-}
-
-nlohmann::json mesh_json(const MeshReport& r) {
-  return {{"vertices", r.vertices},
-          {"faces", r.faces},
-          {"genus", r.genus},
-          {"boundaries", r.boundary_loops}};
 }
 
 }  // namespace
@@ -81,46 +75,6 @@ int run_validate(const ValidateOptions& o, const CommonOptions& common) {
   return result.valid() ? 0 : 2;
 }
 
-namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-// Runs a command that writes into an output folder: report.json is written also on failure,
-// with "status": "failed" and the message, before the error propagates.
-template <typename Body>
-int with_report(const std::string& out_dir, Body&& body) {
-  std::filesystem::create_directories(out_dir);
-  const std::string report_path = (std::filesystem::path(out_dir) / "report.json").string();
-  nlohmann::json report;
-  try {
-    body(report);
-    report["status"] = "ok";
-    write_file_atomic(report_path, report.dump(2) + "\n");
-    return 0;
-  } catch (const std::exception& e) {
-    report["status"] = "failed";
-    report["message"] = e.what();
-    try {
-      write_file_atomic(report_path, report.dump(2) + "\n");
-    } catch (...) {
-    }
-    throw;
-  }
-}
-
-nlohmann::json layout_json(const LayoutTopology& topo) {
-  int irregular = 0;
-  for (int v : topo.valence) irregular += (v != 4);
-  return {{"nodes", topo.num_nodes},
-          {"arcs", topo.num_arcs},
-          {"patches", topo.patches.size()},
-          {"irregular_nodes", irregular}};
-}
-
-}  // namespace
-
 int run_field(const FieldOptions& o, const CommonOptions& common) {
   return with_report(o.out, [&](nlohmann::json& report) {
     const auto t_total = std::chrono::steady_clock::now();
@@ -164,10 +118,6 @@ int run_field(const FieldOptions& o, const CommonOptions& common) {
                 << " s; wrote " << o.out << "/field.txt and report.json\n";
     }
   });
-}
-
-int run_optimize(const OptimizeOptions&, const CommonOptions&) {
-  return not_implemented("optimize", "#4 and #5");
 }
 
 int run_import_quads(const ImportQuadsOptions&, const CommonOptions&) {

@@ -33,6 +33,8 @@ struct OptimizeOptions {
 
 struct ImportQuadsOptions {
   std::string quads, onto, out;
+  bool all_edges = false;  //!< every quad edge is an arc (coarse cages)
+  int refine = 1;          //!< split each quad refine x refine before triangulating
 };
 
 struct PerturbOptions {

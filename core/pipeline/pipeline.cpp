@@ -46,6 +46,67 @@ std::vector<Singularity> Pipeline::singularities() const {
   return out;
 }
 
+const Parameterization& Pipeline::compute_parameterization() {
+  const CrossField& field = field_solver_ ? field_solver_->field() : compute_field();
+  extraction_.reset();
+  if (!param_solver_) {
+    param_solver_ = std::make_unique<ParamSolver>(mesh_, geometry_, layout_, topology_,
+                                                  field.period_jump, field.theta, options_.param);
+    return param_solver_->result();
+  }
+  return param_solver_->solve(mesh_, geometry_, field.theta);
+}
+
+const Parameterization* Pipeline::parameterization() const {
+  return param_solver_ ? &param_solver_->result() : nullptr;
+}
+
+const Extraction& Pipeline::extract() {
+  if (!param_solver_) compute_parameterization();
+  extraction_ = std::make_unique<Extraction>(
+      extract_layout(mesh_, geometry_, layout_, topology_, param_solver_->labeling(),
+                     field_solver_->field().period_jump, param_solver_->result().corner_uv));
+  return *extraction_;
+}
+
+ParamMetrics Pipeline::metrics() {
+  if (!param_solver_) compute_parameterization();
+  if (!curvature_) curvature_ = std::make_unique<Curvature>(compute_curvature(mesh_, geometry_));
+  const auto& r = param_solver_->result();
+  return compute_metrics(mesh_, geometry_, *curvature_, r.corner_uv, r.energy);
+}
+
+Layout Pipeline::output_layout() const {
+  Layout out = layout_;
+  out.mesh_vertices = static_cast<int>(mesh_.n_vertices());
+  out.mesh_faces = static_cast<int>(mesh_.n_faces());
+  if (extraction_) annotate_layout(mesh_, topology_, *extraction_, out);
+  return out;
+}
+
+void write_param_obj(const TriMesh& mesh, const std::vector<std::array<double, 2>>& uv,
+                     const std::string& path) {
+  write_file_atomic(path, [&](std::ostream& out) {
+    char line[160];
+    out << "# QuadSketch parameterization: one vt per face corner\n";
+    for (auto v : mesh.vertices()) {
+      const auto& p = mesh.point(v);
+      std::snprintf(line, sizeof line, "v %.17g %.17g %.17g\n", p[0], p[1], p[2]);
+      out << line;
+    }
+    for (const auto& t : uv) {
+      std::snprintf(line, sizeof line, "vt %.17g %.17g\n", t[0], t[1]);
+      out << line;
+    }
+    int corner = 1;
+    for (auto f : mesh.faces()) {
+      out << 'f';
+      for (auto v : mesh.fv_range(f)) out << ' ' << v.idx() + 1 << '/' << corner++;
+      out << '\n';
+    }
+  });
+}
+
 void write_field_txt(const GeometryCache& geometry, const std::vector<double>& theta,
                      const std::string& path) {
   write_file_atomic(path, [&](std::ostream& out) {

@@ -6,17 +6,21 @@
 #include <string>
 #include <vector>
 
+#include "core/extract/metrics.h"
+#include "core/extract/tracing.h"
 #include "core/field/cross_field.h"
 #include "core/layout/layout.h"
 #include "core/layout/validate.h"
 #include "core/mesh/geometry.h"
 #include "core/mesh/mesh.h"
 #include "core/mesh/mesh_io.h"
+#include "core/param/parameterization.h"
 
 namespace qs {
 
 struct PipelineOptions {
   CrossFieldOptions field;
+  ParamOptions param;
 };
 
 //! A singular vertex of the cross field.
@@ -45,6 +49,17 @@ class Pipeline {
   //! Singular vertices measured on the current field (interior vertices only).
   std::vector<Singularity> singularities() const;
 
+  //! Computes (or re-solves) the parameterization; computes the field first if needed.
+  const Parameterization& compute_parameterization();
+  const Parameterization* parameterization() const;
+  const ParamSolver* param_solver() const { return param_solver_.get(); }
+  //! Traces the arcs on the current parameterization.
+  const Extraction& extract();
+  //! Metrics of the current parameterization (curvature computed once).
+  ParamMetrics metrics();
+  //! The layout with traced arcs, node positions and patches filled in (after extract()).
+  Layout output_layout() const;
+
  private:
   TriMesh mesh_;
   Layout layout_;
@@ -53,7 +68,15 @@ class Pipeline {
   LayoutTopology topology_;
   GeometryCache geometry_;
   std::unique_ptr<CrossFieldSolver> field_solver_;
+  std::unique_ptr<ParamSolver> param_solver_;
+  std::unique_ptr<Extraction> extraction_;
+  std::unique_ptr<Curvature> curvature_;
 };
+
+//! Writes param.obj: the mesh (same vertex and face order) with one texture coordinate per
+//! face corner ("f v/vt"), atomically.
+void write_param_obj(const TriMesh& mesh, const std::vector<std::array<double, 2>>& corner_uv,
+                     const std::string& path);
 
 //! Writes field.txt: one line per face, "x y z", the first field direction (unit, in-plane).
 void write_field_txt(const GeometryCache& geometry, const std::vector<double>& theta,

@@ -1,0 +1,58 @@
+// Helpers shared by the quadsketch-cli subcommands: timing, report.json writing.
+#pragma once
+
+#include <chrono>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "core/base/atomic_file.h"
+#include "core/layout/layout.h"
+#include "core/mesh/mesh_io.h"
+
+namespace qs::cli {
+
+inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+inline nlohmann::json mesh_json(const MeshReport& r) {
+  return {{"vertices", r.vertices},
+          {"faces", r.faces},
+          {"genus", r.genus},
+          {"boundaries", r.boundary_loops}};
+}
+
+inline nlohmann::json layout_json(const LayoutTopology& topo) {
+  int irregular = 0;
+  for (int v : topo.valence) irregular += (v != 4);
+  return {{"nodes", topo.num_nodes},
+          {"arcs", topo.num_arcs},
+          {"patches", topo.patches.size()},
+          {"irregular_nodes", irregular}};
+}
+
+//! Runs a command that writes into an output folder: report.json is written also on failure,
+//! with "status": "failed" and the message, before the error propagates.
+template <typename Body>
+int with_report(const std::string& out_dir, Body&& body) {
+  std::filesystem::create_directories(out_dir);
+  const std::string report_path = (std::filesystem::path(out_dir) / "report.json").string();
+  nlohmann::json report;
+  try {
+    body(report);
+    report["status"] = "ok";
+    write_file_atomic(report_path, report.dump(2) + "\n");
+    return 0;
+  } catch (const std::exception& e) {
+    report["status"] = "failed";
+    report["message"] = e.what();
+    try {
+      write_file_atomic(report_path, report.dump(2) + "\n");
+    } catch (...) {
+    }
+    throw;
+  }
+}
+
+}  // namespace qs::cli

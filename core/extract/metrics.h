@@ -1,0 +1,27 @@
+// Quality metrics of a parameterization (paper §9.1, algorithm.md §8).
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "core/field/curvature.h"
+#include "core/mesh/geometry.h"
+#include "core/mesh/mesh.h"
+
+namespace qs {
+
+struct ParamMetrics {
+  double E = 0;            //!< residual of energy (1) as minimized (length² units)
+  double E_confor = 0;     //!< area-weighted mean of σ1/σ2 + σ2/σ1 (2 = conformal)
+  double E_angle_deg = 0;  //!< E°: curvature-weighted deviation of the iso-lines from the
+                           //!< principal directions, degrees in [0, 45]
+  double E_planar = 0;     //!< conjugacy: (1/√A) Σ A_t |âᵀ S_t b̂| (dimensionless)
+  int foldovers = 0;       //!< faces with signed parametric area ≤ 0
+};
+
+//! Computes the metrics of corner values \p corner_uv (size 3·#F). \p energy is copied into E.
+ParamMetrics compute_metrics(const TriMesh& mesh, const GeometryCache& geometry,
+                             const Curvature& curvature,
+                             const std::vector<std::array<double, 2>>& corner_uv, double energy);
+
+}  // namespace qs

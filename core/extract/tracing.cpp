@@ -1,0 +1,367 @@
+#include "core/extract/tracing.h"
+
+#include <cmath>
+#include <limits>
+
+namespace qs {
+
+namespace {
+
+using HH = OpenMesh::HalfedgeHandle;
+using V2 = std::array<double, 2>;
+
+double cross(const V2& a, const V2& b) {
+  return a[0] * b[1] - a[1] * b[0];
+}
+double dot(const V2& a, const V2& b) {
+  return a[0] * b[0] + a[1] * b[1];
+}
+V2 sub(const V2& a, const V2& b) {
+  return {a[0] - b[0], a[1] - b[1]};
+}
+V2 lerp(const V2& a, const V2& b, double t) {
+  return {a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])};
+}
+double norm(const V2& a) {
+  return std::hypot(a[0], a[1]);
+}
+
+class Tracer {
+ public:
+  Tracer(const TriMesh& mesh, const GeometryCache& g, const std::vector<int>& p,
+         const std::vector<V2>& uv, const std::vector<int>& node_at_vertex, const TraceOptions& opt)
+      : mesh_(mesh), g_(g), p_(p), uv_(uv), node_at_(node_at_vertex), opt_(opt) {}
+
+  TracedArc trace(int start_vertex, int chart_face, int symbol, int end_node, int start_node) {
+    TracedArc out;
+    out.iso_u = symbol % 2 == 1;
+    V2 dir = rotate(symbol, V2{1.0, 0.0});
+    int face = chart_face;
+    if (!find_sector(start_vertex, face, dir))
+      return fail(out, "no start sector at vertex " + std::to_string(start_vertex));
+    add_vertex_sample(out, face, start_vertex);
+    V2 point = at(face, start_vertex);
+    int at_vertex = start_vertex;
+    HH entry;  // halfedge of `face` we entered through (invalid at a vertex)
+    double entry_t = 0;
+    const long cap = static_cast<long>(opt_.max_steps_factor) * g_.n_faces + 16;
+    for (long step = 0; step < cap; ++step) {
+      // Candidates in the current face: vertex hits and edge crossings ahead along dir.
+      const auto& fv = g_.face_vertices[face];
+      const int axis = std::abs(dir[0]) > 0.5 ? 1 : 0;  // constant coordinate
+      const double c = point[axis];
+      double diam = 0;
+      for (int k = 0; k < 3; ++k)
+        diam = std::max(diam, norm(sub(uv_[3 * face + k], uv_[3 * face + (k + 1) % 3])));
+      const double eps = opt_.vertex_snap * std::max(diam, 1e-300);
+      double lam[3];
+      bool snapped[3];
+      for (int k = 0; k < 3; ++k) {
+        lam[k] = uv_[3 * face + k][axis] - c;
+        snapped[k] = std::abs(lam[k]) <= eps;
+      }
+      double best = eps;
+      int best_vertex = -1, best_edge = -1;
+      double best_t = 0;
+      for (int k = 0; k < 3; ++k) {
+        if (fv[k] == at_vertex || !snapped[k]) continue;
+        const double prog = dot(sub(uv_[3 * face + k], point), dir);
+        if (prog > best) best = prog, best_vertex = k, best_edge = -1;
+      }
+      for (int k = 0; k < 3; ++k) {
+        const int l = (k + 1) % 3;
+        if (snapped[k] || snapped[l]) continue;
+        if ((lam[k] > 0) == (lam[l] > 0)) continue;
+        const HH h = mesh_.find_halfedge(mesh_.vertex_handle(fv[k]), mesh_.vertex_handle(fv[l]));
+        if (h == entry) continue;
+        const double t = lam[k] / (lam[k] - lam[l]);
+        const double prog = dot(sub(lerp(uv_[3 * face + k], uv_[3 * face + l], t), point), dir);
+        if (prog > best) best = prog, best_edge = k, best_t = t, best_vertex = -1;
+      }
+      if (best_vertex < 0 && best_edge < 0)
+        return fail(out,
+                    "stuck in face " + std::to_string(face) + " (fold-over or degenerate chart)");
+      out.param_length += best;
+      if (best_vertex >= 0) {
+        const int w = fv[best_vertex];
+        point = uv_[3 * face + best_vertex];
+        add_vertex_sample(out, face, w);
+        if (node_at_[w] >= 0) {
+          if (node_at_[w] == end_node) {
+            out.ok = true;
+            return out;
+          }
+          return fail(out, "runs into node " + std::to_string(node_at_[w]) + " (vertex " +
+                               std::to_string(w) + ")");
+        }
+        if (mesh_.is_boundary(mesh_.vertex_handle(w)) && end_node < 0) {
+          out.ok = true;
+          return out;
+        }
+        at_vertex = w;
+        entry = HH();
+        if (!find_sector(w, face, dir))
+          return fail(out, "no continuation at vertex " + std::to_string(w));
+        point = at(face, w);
+        continue;
+      }
+      // Edge crossing.
+      const int k = best_edge, l = (k + 1) % 3;
+      const HH h = mesh_.find_halfedge(mesh_.vertex_handle(fv[k]), mesh_.vertex_handle(fv[l]));
+      add_edge_sample(out, face, k, best_t);
+      const HH opp = mesh_.opposite_halfedge_handle(h);
+      if (mesh_.is_boundary(opp)) {
+        if (end_node < 0) {
+          out.ok = true;
+          return out;
+        }
+        return fail(out, "leaves the surface at edge (" + std::to_string(fv[k]) + ", " +
+                             std::to_string(fv[l]) + ")");
+      }
+      const int next = mesh_.face_handle(opp).idx();
+      const int r = step_rotation(p_[mesh_.edge_handle(h).idx()], fv[k], fv[l]);
+      dir = rotate(r, dir);
+      point = lerp(at(next, fv[k]), at(next, fv[l]), best_t);
+      face = next;
+      entry = opp;
+      entry_t = best_t;
+      at_vertex = -1;
+    }
+    (void)entry_t;
+    (void)start_node;
+    return fail(out, "step limit reached");
+  }
+
+ private:
+  V2 at(int f, int v) const { return uv_[3 * f + corner_of(g_, f, v)]; }
+
+  TracedArc& fail(TracedArc& out, std::string why) {
+    out.ok = false;
+    out.failure = std::move(why);
+    return out;
+  }
+
+  // Is `dir` inside the corner wedge of face f at vertex w (in f's chart)?
+  bool in_wedge(int f, int w, const V2& dir) const {
+    const int k = corner_of(g_, f, w);
+    const V2 W = uv_[3 * f + k];
+    V2 a = sub(uv_[3 * f + (k + 1) % 3], W), b = sub(uv_[3 * f + (k + 2) % 3], W);
+    const double la = norm(a), lb = norm(b);
+    if (la == 0 || lb == 0) return false;
+    a = {a[0] / la, a[1] / la};
+    b = {b[0] / lb, b[1] / lb};
+    if (cross(a, b) <= 0) return false;  // folded corner
+    const double tol = 1e-9;
+    return cross(a, dir) >= -tol && cross(dir, b) >= -tol;
+  }
+
+  // Finds the face around w (starting at `face`, sweeping both ways with transitions) whose
+  // corner wedge contains dir; updates face and dir to that face's chart.
+  bool find_sector(int w, int& face, V2& dir) const {
+    if (in_wedge(face, w, dir)) return true;
+    const auto vw = mesh_.vertex_handle(w);
+    // Outgoing halfedge of w in `face`.
+    HH o0;
+    for (auto h : mesh_.fh_range(mesh_.face_handle(face)))
+      if (mesh_.from_vertex_handle(h) == vw) o0 = h;
+    int degree = 0;
+    for (auto h : mesh_.voh_range(vw)) (void)h, ++degree;
+    HH cw = o0, ccw = o0;
+    V2 dcw = dir, dccw = dir;
+    bool cw_open = true, ccw_open = true;
+    for (int s = 0; s < degree && (cw_open || ccw_open); ++s) {
+      if (cw_open) {  // cross edge of cw from face(cw) to face(opp(cw))
+        const HH opp = mesh_.opposite_halfedge_handle(cw);
+        if (mesh_.is_boundary(opp)) {
+          cw_open = false;
+        } else {
+          dcw = rotate(
+              step_rotation(p_[mesh_.edge_handle(cw).idx()], w, mesh_.to_vertex_handle(cw).idx()),
+              dcw);
+          cw = mesh_.next_halfedge_handle(opp);
+          const int f = mesh_.face_handle(cw).idx();
+          if (in_wedge(f, w, dcw)) {
+            face = f, dir = dcw;
+            return true;
+          }
+        }
+      }
+      if (ccw_open) {  // cross the edge of prev(ccw) (b→w) from face(ccw) to face(w→b)
+        const HH in = mesh_.prev_halfedge_handle(ccw);
+        const HH out = mesh_.opposite_halfedge_handle(in);
+        if (mesh_.is_boundary(out)) {
+          ccw_open = false;
+        } else {
+          dccw = rotate(
+              step_rotation(p_[mesh_.edge_handle(in).idx()], mesh_.from_vertex_handle(in).idx(), w),
+              dccw);
+          ccw = out;
+          const int f = mesh_.face_handle(ccw).idx();
+          if (in_wedge(f, w, dccw)) {
+            face = f, dir = dccw;
+            return true;
+          }
+        }
+      }
+    }
+    return false;
+  }
+
+  void add_vertex_sample(TracedArc& out, int f, int v) {
+    SurfacePoint sp;
+    sp.face = f;
+    sp.bary = {0, 0, 0};
+    sp.bary[corner_of(g_, f, v)] = 1;
+    out.samples.push_back(sp);
+    const auto& x = mesh_.point(mesh_.vertex_handle(v));
+    out.polyline.push_back({x[0], x[1], x[2]});
+    out.uv.push_back(at(f, v));
+  }
+
+  void add_edge_sample(TracedArc& out, int f, int k, double t) {
+    const int l = (k + 1) % 3;
+    SurfacePoint sp;
+    sp.face = f;
+    sp.bary = {0, 0, 0};
+    sp.bary[k] = 1 - t;
+    sp.bary[l] = t;
+    out.samples.push_back(sp);
+    const auto& fv = g_.face_vertices[f];
+    const Vec3 x = (1 - t) * mesh_.point(mesh_.vertex_handle(fv[k])) +
+                   t * mesh_.point(mesh_.vertex_handle(fv[l]));
+    out.polyline.push_back({x[0], x[1], x[2]});
+    out.uv.push_back(lerp(uv_[3 * f + k], uv_[3 * f + l], t));
+  }
+
+  const TriMesh& mesh_;
+  const GeometryCache& g_;
+  const std::vector<int>& p_;
+  const std::vector<V2>& uv_;
+  const std::vector<int>& node_at_;
+  TraceOptions opt_;
+};
+
+}  // namespace
+
+Extraction extract_layout(const TriMesh& mesh, const GeometryCache& g, const Layout& layout,
+                          const LayoutTopology& topo, const Labeling& labeling,
+                          const std::vector<int>& p, const std::vector<V2>& uv,
+                          const TraceOptions& opt) {
+  Extraction ex;
+  std::vector<int> node_at(g.n_vertices, -1);
+  for (int n = 0; n < topo.num_nodes; ++n) node_at[layout.nodes[n].vertex] = n;
+  Tracer tracer(mesh, g, p, uv, node_at, opt);
+  ex.arcs.resize(topo.num_arcs);
+  for (int a = 0; a < topo.num_arcs; ++a) {
+    const int h = 2 * a;
+    const int start_node = topo.half_node[h];
+    const int end_node = topo.half_node[h + 1];
+    ex.arcs[a] = tracer.trace(layout.nodes[start_node].vertex, labeling.chart_face[h],
+                              labeling.symbol[h], end_node, start_node);
+    if (!ex.arcs[a].ok)
+      ex.problems.push_back("arc " + std::to_string(layout.arcs[a].id) + ": " + ex.arcs[a].failure);
+  }
+  // Crossings: segments of different arcs inside one face (in that face's chart).
+  std::vector<std::vector<std::pair<int, int>>> face_segments(g.n_faces);  // (arc, sample index)
+  for (int a = 0; a < topo.num_arcs; ++a) {
+    const auto& s = ex.arcs[a].samples;
+    for (size_t i = 0; i + 1 < s.size(); ++i) {
+      // Segment i..i+1 lies in the face of sample i+1's predecessor crossing: both samples are
+      // on the boundary of a common face; use sample i+1's face when it is the one traversed.
+      face_segments[s[i + 1].face].push_back({a, static_cast<int>(i)});
+    }
+  }
+  auto local_uv = [&](const SurfacePoint& sp, int f) { return uv_in_face(mesh, g, uv, sp, f); };
+  for (int f = 0; f < g.n_faces; ++f) {
+    const auto& segs = face_segments[f];
+    for (size_t i = 0; i < segs.size(); ++i)
+      for (size_t j = i + 1; j < segs.size(); ++j) {
+        if (segs[i].first == segs[j].first) continue;
+        const auto& si = ex.arcs[segs[i].first].samples;
+        const auto& sj = ex.arcs[segs[j].first].samples;
+        const V2 a0 = local_uv(si[segs[i].second], f), a1 = local_uv(si[segs[i].second + 1], f);
+        const V2 b0 = local_uv(sj[segs[j].second], f), b1 = local_uv(sj[segs[j].second + 1], f);
+        const double d1 = cross(sub(a1, a0), sub(b0, a0)), d2 = cross(sub(a1, a0), sub(b1, a0));
+        const double d3 = cross(sub(b1, b0), sub(a0, b0)), d4 = cross(sub(b1, b0), sub(a1, b0));
+        const double tol = 1e-12 * (norm(sub(a1, a0)) * norm(sub(b1, b0)) + 1e-300);
+        if (((d1 > tol && d2 < -tol) || (d1 < -tol && d2 > tol)) &&
+            ((d3 > tol && d4 < -tol) || (d3 < -tol && d4 > tol))) {
+          ++ex.crossings;
+          if (ex.crossings <= 5)
+            ex.problems.push_back("arcs " + std::to_string(layout.arcs[segs[i].first].id) +
+                                  " and " + std::to_string(layout.arcs[segs[j].first].id) +
+                                  " cross in face " + std::to_string(f));
+        }
+      }
+  }
+  // Patch sizes: lengths of the first two sides.
+  ex.patch_size.resize(topo.patches.size());
+  for (size_t pi = 0; pi < topo.patches.size(); ++pi) {
+    const auto& darts = topo.patches[pi].darts;
+    if (darts.size() >= 2)
+      ex.patch_size[pi] = {ex.arcs[darts[0] >> 1].param_length,
+                           ex.arcs[darts[1] >> 1].param_length};
+  }
+  bool all_ok = true;
+  for (const auto& t : ex.arcs) all_ok &= t.ok;
+  ex.structurally_equivalent = all_ok && ex.crossings == 0;
+  return ex;
+}
+
+std::array<double, 2> uv_in_face(const TriMesh& mesh, const GeometryCache& g,
+                                 const std::vector<V2>& uv, const SurfacePoint& sp, int f) {
+  const auto& sv = g.face_vertices[sp.face];
+  const Vec3 x = sp.bary[0] * mesh.point(mesh.vertex_handle(sv[0])) +
+                 sp.bary[1] * mesh.point(mesh.vertex_handle(sv[1])) +
+                 sp.bary[2] * mesh.point(mesh.vertex_handle(sv[2]));
+  const auto& fv = g.face_vertices[f];
+  const Vec3 p0 = mesh.point(mesh.vertex_handle(fv[0])), p1 = mesh.point(mesh.vertex_handle(fv[1])),
+             p2 = mesh.point(mesh.vertex_handle(fv[2]));
+  const Vec3 n = (p1 - p0) % (p2 - p0);
+  const double a2 = n.sqrnorm();
+  const double b1 = (((x - p0) % (p2 - p0)) | n) / a2, b2 = (((p1 - p0) % (x - p0)) | n) / a2;
+  return V2{(1 - b1 - b2) * uv[3 * f][0] + b1 * uv[3 * f + 1][0] + b2 * uv[3 * f + 2][0],
+            (1 - b1 - b2) * uv[3 * f][1] + b1 * uv[3 * f + 1][1] + b2 * uv[3 * f + 2][1]};
+}
+
+void annotate_layout(const TriMesh& mesh, const LayoutTopology& topo, const Extraction& ex,
+                     Layout& layout) {
+  for (int n = 0; n < topo.num_nodes; ++n) {
+    auto& node = layout.nodes[n];
+    const auto v = mesh.vertex_handle(node.vertex);
+    const auto& x = mesh.point(v);
+    node.position = std::array<double, 3>{x[0], x[1], x[2]};
+    node.valence = topo.valence[n];
+    // A face containing the vertex, with barycentric 1 at it.
+    for (auto f : mesh.vf_range(v)) {
+      SurfacePoint sp;
+      sp.face = f.idx();
+      sp.bary = {0, 0, 0};
+      int k = 0;
+      for (auto w : mesh.fv_range(f)) {
+        if (w == v) sp.bary[k] = 1;
+        ++k;
+      }
+      node.point = sp;
+      break;
+    }
+  }
+  for (int a = 0; a < topo.num_arcs; ++a) {
+    auto& arc = layout.arcs[a];
+    const auto& t = ex.arcs[a];
+    arc.label = t.iso_u ? "u" : "v";
+    arc.samples = t.samples;
+    arc.polyline = t.polyline;
+  }
+  layout.patches.clear();
+  for (size_t pi = 0; pi < topo.patches.size(); ++pi) {
+    LayoutPatch patch;
+    patch.id = static_cast<int>(pi);
+    for (int c : topo.patches[pi].corners) patch.nodes.push_back(layout.nodes[c].id);
+    for (int d : topo.patches[pi].darts) patch.arcs.push_back(layout.arcs[d >> 1].id);
+    patch.size = ex.patch_size[pi];
+    layout.patches.push_back(patch);
+  }
+}
+
+}  // namespace qs

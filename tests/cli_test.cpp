@@ -1,0 +1,197 @@
+// quadsketch-cli end to end: exit codes, the bad-input corpus, and the output files.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <sstream>
+
+#include "core/layout/layout_io.h"
+#include "core/layout/validate.h"
+#include "core/mesh/mesh_io.h"
+#include "tests/fixtures.h"
+
+namespace qs {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kMesh = test::assets_dir() + "/example/ellipsoid.obj";
+const std::string kLayout = test::assets_dir() + "/example/ellipsoid.layout.json";
+
+std::string cli(const std::string& args) {
+  return test::cli_path() + " " + args;
+}
+
+nlohmann::json read_json(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+// Expected words per broken mesh, from the table in assets/bad/README.md.
+std::map<std::string, std::vector<std::string>> mesh_expectations() {
+  std::map<std::string, std::vector<std::string>> out;
+  std::ifstream in(test::assets_dir() + "/bad/README.md");
+  std::string line;
+  const std::regex row(R"(^\| `([^`]+)` \|.*\| (.*) \|\s*$)");
+  const std::regex word("`([^`]+)`");
+  while (std::getline(in, line)) {
+    std::smatch m;
+    if (!std::regex_match(line, m, row)) continue;
+    const std::string cell = m[2];
+    for (auto it = std::sregex_iterator(cell.begin(), cell.end(), word);
+         it != std::sregex_iterator(); ++it)
+      out[m[1]].push_back((*it)[1]);
+  }
+  return out;
+}
+
+const std::map<std::string, std::vector<std::string>> kLayoutExpectations = {
+    {"crossing_arcs.layout.json", {"arc_crossing", "arcs 0 and 100"}},
+    {"five_sided_patch.layout.json", {"patch_valence", "5 corners", "a full patch needs 4"}},
+    {"missing_node.layout.json", {"unknown_node", "arc 3", "unknown node 42"}},
+    {"malformed.layout.json", {"malformed JSON", "line"}},
+};
+
+TEST(Cli, VersionAndUsage) {
+  std::string out;
+  EXPECT_EQ(test::run_command(cli("--version"), &out), 0);
+  EXPECT_NE(out.find("quadsketch-cli"), std::string::npos);
+  EXPECT_EQ(test::run_command(cli("validate --help"), &out), 0);
+  EXPECT_NE(out.find("--layout"), std::string::npos);
+  EXPECT_EQ(test::run_command(cli("validate --mesh " + kMesh), &out), 1)
+      << out;  // --layout missing
+  EXPECT_EQ(test::run_command(cli("frobnicate"), &out), 1) << out;
+}
+
+TEST(Cli, ValidatesTheExample) {
+  std::string out;
+  ASSERT_EQ(test::run_command(cli("validate --mesh " + kMesh + " --layout " + kLayout), &out), 0)
+      << out;
+  EXPECT_NE(out.find("8 nodes (8 irregular), 12 arcs, 6 patches"), std::string::npos) << out;
+}
+
+TEST(Cli, MissingFileIsInvalidInput) {
+  std::string out;
+  EXPECT_EQ(test::run_command(cli("validate --mesh /nonexistent/x.obj --layout " + kLayout), &out),
+            2)
+      << out;
+  EXPECT_NE(out.find("/nonexistent/x.obj"), std::string::npos) << out;
+}
+
+TEST(Cli, EveryBrokenInputGivesItsErrorAndExitCode2) {
+  const auto mesh_words = mesh_expectations();
+  int checked = 0;
+  for (const auto& entry : fs::directory_iterator(test::assets_dir() + "/bad")) {
+    const std::string name = entry.path().filename().string();
+    if (name == "README.md") continue;
+    std::string out;
+    int code;
+    std::vector<std::string> words;
+    if (name.size() > 12 && name.substr(name.size() - 12) == ".layout.json") {
+      ASSERT_TRUE(kLayoutExpectations.count(name)) << "no expectation for " << name;
+      words = kLayoutExpectations.at(name);
+      code = test::run_command(
+          cli("validate --mesh " + kMesh + " --layout " + entry.path().string()), &out);
+    } else {
+      ASSERT_TRUE(mesh_words.count(name)) << name << " has no row in assets/bad/README.md";
+      words = mesh_words.at(name);
+      code = test::run_command(
+          cli("validate --mesh " + entry.path().string() + " --layout " + kLayout), &out);
+    }
+    EXPECT_EQ(code, 2) << name << ":\n" << out;
+    for (const auto& w : words)
+      EXPECT_NE(out.find(w), std::string::npos) << name << ": missing '" << w << "' in\n" << out;
+    ++checked;
+  }
+  EXPECT_GE(checked, 10);
+}
+
+TEST(Cli, FailedRunsWriteAFailedReport) {
+  const std::string dir = test::temp_dir("cli_failed");
+  std::string out;
+  const int code =
+      test::run_command(cli("optimize --no-node-opt --mesh " + kMesh + " --layout " +
+                            test::assets_dir() + "/bad/five_sided_patch.layout.json --out " + dir),
+                        &out);
+  EXPECT_EQ(code, 2) << out;
+  const auto report = read_json(dir + "/report.json");
+  EXPECT_EQ(report["status"], "failed");
+  EXPECT_NE(report["message"].get<std::string>().find("patch_valence"), std::string::npos);
+}
+
+TEST(Cli, FieldWritesSingularitiesAndDirections) {
+  const std::string dir = test::temp_dir("cli_field");
+  std::string out;
+  ASSERT_EQ(test::run_command(
+                cli("field --mesh " + kMesh + " --layout " + kLayout + " --out " + dir), &out),
+            0)
+      << out;
+  const auto report = read_json(dir + "/report.json");
+  EXPECT_EQ(report["status"], "ok");
+  ASSERT_EQ(report["singularities"].size(), 8u);
+  for (const auto& s : report["singularities"]) EXPECT_DOUBLE_EQ(s["index"].get<double>(), 0.25);
+  const TriMesh mesh = load_mesh(kMesh);
+  std::ifstream field(dir + "/field.txt");
+  int lines = 0;
+  double x, y, z;
+  while (field >> x >> y >> z) {
+    EXPECT_NEAR(x * x + y * y + z * z, 1.0, 1e-6);
+    ++lines;
+  }
+  EXPECT_EQ(lines, static_cast<int>(mesh.n_faces()));
+}
+
+TEST(Cli, OptimizeWithoutNodeOptimizationWritesEverything) {
+  const std::string dir = test::temp_dir("cli_optimize");
+  std::string out;
+  ASSERT_EQ(test::run_command(cli("optimize --no-node-opt --mesh " + kMesh + " --layout " +
+                                  kLayout + " --out " + dir),
+                              &out),
+            0)
+      << out;
+  const auto report = read_json(dir + "/report.json");
+  EXPECT_EQ(report["status"], "ok");
+  EXPECT_TRUE(report["structurally_equivalent"].get<bool>());
+  EXPECT_EQ(report["metrics"]["foldovers"], 0);
+  EXPECT_GT(report["E_final"].get<double>(), 0.0);
+  EXPECT_GE(report["metrics"]["E_confor"].get<double>(), 2.0);
+  for (const char* key :
+       {"load", "field", "parameterization", "node_optimization", "extraction", "total"})
+    EXPECT_TRUE(report["timings_s"].contains(key)) << key;
+  // param.obj: same vertices and faces, one vt per corner.
+  const TriMesh mesh = load_mesh(kMesh);
+  std::ifstream obj(dir + "/param.obj");
+  std::string line;
+  int v = 0, vt = 0, f = 0;
+  while (std::getline(obj, line)) {
+    if (line.rfind("v ", 0) == 0) ++v;
+    if (line.rfind("vt ", 0) == 0) ++vt;
+    if (line.rfind("f ", 0) == 0) {
+      ++f;
+      EXPECT_NE(line.find('/'), std::string::npos);
+    }
+  }
+  EXPECT_EQ(v, static_cast<int>(mesh.n_vertices()));
+  EXPECT_EQ(f, static_cast<int>(mesh.n_faces()));
+  EXPECT_EQ(vt, 3 * f);
+  // layout.json is a valid input layout carrying the traced arcs.
+  const Layout layout = load_layout(dir + "/layout.json", mesh);
+  EXPECT_TRUE(validate_layout(mesh, layout).valid());
+  EXPECT_EQ(layout.patches.size(), 6u);
+  for (const auto& arc : layout.arcs) {
+    EXPECT_TRUE(arc.label == "u" || arc.label == "v");
+    EXPECT_GE(arc.samples.size(), 2u);
+    EXPECT_EQ(arc.samples.size(), arc.polyline.size());
+  }
+  for (const auto& p : layout.patches) {
+    EXPECT_EQ(p.nodes.size(), 4u);
+    EXPECT_GT(p.size[0], 0);
+    EXPECT_GT(p.size[1], 0);
+  }
+}
+
+}  // namespace
+}  // namespace qs
