@@ -18,13 +18,18 @@ class Camera {
   //! Window size in logical pixels.
   void set_viewport(int width, int height);
   glm::vec2 viewport() const { return {float(width_), float(height_)}; }
+  //! Horizontal shift of the view centre in pixels (e.g. half the width of a side panel), so
+  //! that the scene centres in the visible part of the window.
+  void set_view_offset(float pixels) { view_offset_px_ = pixels; }
 
   //! Bounding sphere of the scene: used by reset() and for the clipping planes.
   void set_scene(const glm::vec3& center, float radius);
   //! Home view: looking down -z at the whole scene (animated unless \p immediate).
   void reset(bool immediate = false);
-  //! Centers on a sphere and zooms so that it fills about half the view (animated).
-  void focus(const glm::vec3& center, float radius);
+  //! Centers on a sphere and zooms so that it fills about half the view (animated). With a
+  //! non-zero \p normal, also turns (by the smallest rotation) to look at it from that side,
+  //! so that a point on the far side of the surface comes into view from outside.
+  void focus(const glm::vec3& center, float radius, const glm::vec3& normal = glm::vec3(0.0f));
 
   //! Trackball drag: begin at a screen point, then move to further points.
   void begin_orbit(const glm::vec2& screen);
@@ -53,6 +58,7 @@ class Camera {
 
   int width_ = 1;
   int height_ = 1;
+  float view_offset_px_ = 0.0f;
   float fov_y_rad_ = glm::radians(35.0f);
   glm::quat rotation_{1.0f, 0.0f, 0.0f, 0.0f};
   glm::vec3 target_{0.0f};

@@ -79,10 +79,18 @@ bool GlProgram::build(const std::string& vertex_name, const std::string& fragmen
   return true;
 }
 
-void GlProgram::use() const { glUseProgram(id_); }
-GLint GlProgram::uniform(const char* name) const { return glGetUniformLocation(id_, name); }
-void GlProgram::set(const char* name, int value) const { glUniform1i(uniform(name), value); }
-void GlProgram::set(const char* name, float value) const { glUniform1f(uniform(name), value); }
+void GlProgram::use() const {
+  glUseProgram(id_);
+}
+GLint GlProgram::uniform(const char* name) const {
+  return glGetUniformLocation(id_, name);
+}
+void GlProgram::set(const char* name, int value) const {
+  glUniform1i(uniform(name), value);
+}
+void GlProgram::set(const char* name, float value) const {
+  glUniform1f(uniform(name), value);
+}
 void GlProgram::set(const char* name, const glm::vec2& v) const {
   glUniform2fv(uniform(name), 1, glm::value_ptr(v));
 }

@@ -12,10 +12,14 @@ namespace qs::render {
 
 glm::vec3 LayoutColors::valence(int valence) {
   switch (valence) {
-    case 4: return {0.93f, 0.93f, 0.91f};  // regular: neutral
-    case 3: return {0.22f, 0.56f, 0.97f};
-    case 5: return {0.97f, 0.47f, 0.13f};
-    default: return {0.78f, 0.28f, 0.88f};  // anything else stands out
+    case 4:
+      return {0.93f, 0.93f, 0.91f};  // regular: neutral
+    case 3:
+      return {0.22f, 0.56f, 0.97f};
+    case 5:
+      return {0.97f, 0.47f, 0.13f};
+    default:
+      return {0.78f, 0.28f, 0.88f};  // anything else stands out
   }
 }
 
@@ -27,8 +31,8 @@ glm::vec3 LayoutColors::label(const std::string& label) {
 
 namespace {
 
-constexpr int kLineFloats = 11;   // p0, p1, rgba, width
-constexpr int kPointFloats = 9;   // position, rgba, size, ring
+constexpr int kLineFloats = 11;  // p0, p1, rgba, width
+constexpr int kPointFloats = 9;  // position, rgba, size, ring
 
 void push_point(std::vector<float>& out, const glm::vec3& p, const glm::vec3& c, float alpha,
                 float size, float ring) {
@@ -49,7 +53,9 @@ glm::vec3 vertex_position(const TriMesh& mesh, int v) {
   return {float(p[0]), float(p[1]), float(p[2])};
 }
 
-bool valid_vertex(const TriMesh& mesh, int v) { return v >= 0 && v < int(mesh.n_vertices()); }
+bool valid_vertex(const TriMesh& mesh, int v) {
+  return v >= 0 && v < int(mesh.n_vertices());
+}
 
 }  // namespace
 
@@ -64,10 +70,12 @@ bool LayoutLayer::reload(std::string* log) {
 }
 
 void LayoutLayer::upload(const SceneData& data) {
-  const std::vector<std::uint64_t> key = {
-      reinterpret_cast<std::uintptr_t>(data.mesh), data.mesh_version,
-      reinterpret_cast<std::uintptr_t>(data.layout), data.layout_version, data.issues_version,
-      data.interaction_version};
+  const std::vector<std::uint64_t> key = {reinterpret_cast<std::uintptr_t>(data.mesh),
+                                          data.mesh_version,
+                                          reinterpret_cast<std::uintptr_t>(data.layout),
+                                          data.layout_version,
+                                          data.issues_version,
+                                          data.interaction_version};
   if (key == uploaded_key_) return;
   uploaded_key_ = key;
   arc_segments_ = nodes_ = issue_points_ = 0;
@@ -136,8 +144,8 @@ void LayoutLayer::upload(const SceneData& data) {
       float size = node_size;
       if (node.id == data.hovered_node || node.id == data.arc_start_node) size *= 1.3f;
       const float ring = node.id == data.selected_node || node.id == data.arc_start_node ? 2.0f
-                         : node.pinned                                                 ? 1.0f
-                                                                                       : 0.0f;
+                         : node.pinned                                                   ? 1.0f
+                                                                                         : 0.0f;
       if (ring > 0.0f) size *= 1.25f;
       push_point(points, p, color, 1.0f, size, ring);
     }
@@ -177,8 +185,7 @@ void LayoutLayer::upload(const SceneData& data) {
   issue_points_ = static_cast<int>(issues.size() / kPointFloats);
 }
 
-void LayoutLayer::draw_lines(const FrameContext& frame, GlVertexArray& vao, int count,
-                             float pull) {
+void LayoutLayer::draw_lines(const FrameContext& frame, GlVertexArray& vao, int count, float pull) {
   lines_.use();
   lines_.set("u_view", frame.camera->view());
   lines_.set("u_proj", frame.camera->projection());
@@ -190,8 +197,8 @@ void LayoutLayer::draw_lines(const FrameContext& frame, GlVertexArray& vao, int 
   glDrawArraysInstanced(GL_TRIANGLES, 0, 6, count);
 }
 
-void LayoutLayer::draw_points(const FrameContext& frame, GlVertexArray& vao, int count,
-                              float scale, float pull) {
+void LayoutLayer::draw_points(const FrameContext& frame, GlVertexArray& vao, int count, float scale,
+                              float pull) {
   points_.use();
   points_.set("u_view", frame.camera->view());
   points_.set("u_proj", frame.camera->projection());

@@ -12,7 +12,9 @@ MeshLayer::MeshLayer() {
   if (!reload(&log)) throw std::runtime_error("mesh shader: " + log);
 }
 
-bool MeshLayer::reload(std::string* log) { return program_.build("mesh.vert", "mesh.frag", log); }
+bool MeshLayer::reload(std::string* log) {
+  return program_.build("mesh.vert", "mesh.frag", log);
+}
 
 void MeshLayer::upload(const SceneData& data) {
   const bool mesh_changed = data.mesh != mesh_ptr_ || data.mesh_version != mesh_version_;
@@ -29,7 +31,8 @@ void MeshLayer::upload(const SceneData& data) {
       for (auto fh : mesh.faces()) {
         auto it = mesh.cfv_begin(fh);
         const auto a = *it++, b = *it++, c = *it;
-        const Vec3 n = OpenMesh::cross(mesh.point(b) - mesh.point(a), mesh.point(c) - mesh.point(a));
+        const Vec3 n =
+            OpenMesh::cross(mesh.point(b) - mesh.point(a), mesh.point(c) - mesh.point(a));
         normals[a.idx()] += n;
         normals[b.idx()] += n;
         normals[c.idx()] += n;

@@ -14,8 +14,8 @@ struct SurfaceHit {
   int face = -1;
   //! Barycentric coordinates w.r.t. the face's vertices in OpenMesh face-vertex order.
   std::array<double, 3> bary{{1.0 / 3, 1.0 / 3, 1.0 / 3}};
-  double distance = 0.0;   //!< along the ray
-  int nearest_vertex = -1; //!< the face vertex with the largest barycentric coordinate
+  double distance = 0.0;    //!< along the ray
+  int nearest_vertex = -1;  //!< the face vertex with the largest barycentric coordinate
   glm::dvec3 position{0.0};
 };
 

@@ -64,7 +64,7 @@ void main() {
   if (u_wireframe) {
     float d = edge_distance_px();
     float line = 1.0 - clamp(d - 0.5 * u_wire_width + 0.5, 0.0, 1.0);
-    color = mix(color, u_wire_color, line * 0.85);
+    color = mix(color, u_wire_color, line * 0.6);
   }
   frag_color = vec4(color, 1.0);
 }

@@ -33,10 +33,14 @@ TriMesh grid(int n) {
   return mesh;
 }
 
-int vid(int i, int j, int n = 10) { return j * (n + 1) + i; }
+int vid(int i, int j, int n = 10) {
+  return j * (n + 1) + i;
+}
 
 // Exact comparison through the serializer, which writes every field.
-std::string dump(const Layout& layout) { return layout_to_json(layout); }
+std::string dump(const Layout& layout) {
+  return layout_to_json(layout);
+}
 
 class LayoutEditorTest : public ::testing::Test {
  protected:
@@ -109,8 +113,9 @@ TEST_F(LayoutEditorTest, ArcsFollowMeshEdgesBetweenTheirNodes) {
     EXPECT_EQ(arc.path.front(), layout.nodes[layout.node_index(arc.from)].vertex);
     EXPECT_EQ(arc.path.back(), layout.nodes[layout.node_index(arc.to)].vertex);
     for (std::size_t i = 0; i + 1 < arc.path.size(); ++i)
-      EXPECT_TRUE(mesh_.find_halfedge(OpenMesh::VertexHandle(arc.path[i]),
-                                      OpenMesh::VertexHandle(arc.path[i + 1]))
+      EXPECT_TRUE(mesh_
+                      .find_halfedge(OpenMesh::VertexHandle(arc.path[i]),
+                                     OpenMesh::VertexHandle(arc.path[i + 1]))
                       .is_valid());
   }
 }
@@ -131,13 +136,13 @@ TEST_F(LayoutEditorTest, RefusedEditsChangeNothing) {
   const std::string before = dump(editor_.layout());
   const auto history = editor_.history_size();
   const auto version = editor_.version();
-  EXPECT_FALSE(editor_.add_node(vid(2, 2)).ok);                 // node already there
+  EXPECT_FALSE(editor_.add_node(vid(2, 2)).ok);                         // node already there
   EXPECT_FALSE(editor_.add_node(editor_.layout().arcs[0].path[1]).ok);  // on an arc
-  EXPECT_FALSE(editor_.add_node(100000).ok);                    // out of range
-  EXPECT_FALSE(editor_.add_arc(ids_[0], ids_[0]).ok);           // loop
-  EXPECT_FALSE(editor_.add_arc(ids_[0], 999).ok);               // unknown node
+  EXPECT_FALSE(editor_.add_node(100000).ok);                            // out of range
+  EXPECT_FALSE(editor_.add_arc(ids_[0], ids_[0]).ok);                   // loop
+  EXPECT_FALSE(editor_.add_arc(ids_[0], 999).ok);                       // unknown node
   EXPECT_FALSE(editor_.delete_arc(999).ok);
-  EXPECT_FALSE(editor_.move_node(ids_[0], vid(8, 8)).ok);       // occupied by a node
+  EXPECT_FALSE(editor_.move_node(ids_[0], vid(8, 8)).ok);                      // occupied by a node
   EXPECT_FALSE(editor_.split_arc(editor_.layout().arcs[0].id, vid(2, 2)).ok);  // an end
   EXPECT_EQ(dump(editor_.layout()), before);
   EXPECT_EQ(editor_.history_size(), history);
@@ -164,8 +169,12 @@ TEST_F(LayoutEditorTest, MovingANodeReroutesItsArcs) {
   ASSERT_TRUE(editor_.move_node(ids_[2], vid(9, 9)).ok);
   const Layout& layout = editor_.layout();
   for (const auto& arc : layout.arcs) {
-    if (arc.from == ids_[2]) EXPECT_EQ(arc.path.front(), vid(9, 9));
-    if (arc.to == ids_[2]) EXPECT_EQ(arc.path.back(), vid(9, 9));
+    if (arc.from == ids_[2]) {
+      EXPECT_EQ(arc.path.front(), vid(9, 9));
+    }
+    if (arc.to == ids_[2]) {
+      EXPECT_EQ(arc.path.back(), vid(9, 9));
+    }
   }
 }
 
@@ -221,8 +230,8 @@ class ScopedEnv {
 };
 
 fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("qs_gui_test_" + name + "_" +
-                                                    std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("qs_gui_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;

@@ -60,7 +60,9 @@ TEST(Worker, RunPublishesOrderedSnapshotsUntilFinished) {
   do {
     s = worker.latest();
     EXPECT_GE(s->version, last_version);
-    if (s->generation == worker.latest()->generation) EXPECT_GE(s->iteration, last_iteration);
+    if (s->generation == worker.latest()->generation) {
+      EXPECT_GE(s->iteration, last_iteration);
+    }
     last_version = s->version;
     last_iteration = s->iteration;
     std::this_thread::yield();
@@ -122,10 +124,10 @@ TEST(Worker, PinsAreAppliedAtTheNextStep) {
     r.validate = false;
     return r;
   });
-  worker.send(cmd::LoadMesh{tetrahedron(), Layout{}});
+  const auto load_seq = worker.send(cmd::LoadMesh{tetrahedron(), Layout{}});
   const auto pin_seq = worker.send(cmd::SetPin{7, 3});
   // The pin is drained but not applied: no step ran, so applied_seq stays below it.
-  auto s = worker.wait_for([](const Snapshot& x) { return x.version >= 2; }, 2s);
+  auto s = worker.wait_for([&](const Snapshot& x) { return x.applied_seq >= load_seq; }, 2s);
   std::this_thread::sleep_for(20ms);
   s = worker.latest();
   EXPECT_LT(s->applied_seq, pin_seq);

@@ -15,15 +15,6 @@
 
 namespace qs::cli {
 
-namespace {
-
-int not_implemented(const std::string& command, const std::string& issue) {
-  std::cerr << "error: quadsketch-cli " << command << " is not implemented yet (tracked in issue "
-            << issue << ")\n";
-  return 1;
-}
-
-}  // namespace
 
 int run_validate(const ValidateOptions& o, const CommonOptions& common) {
   MeshReport report;
@@ -118,14 +109,6 @@ int run_field(const FieldOptions& o, const CommonOptions& common) {
                 << " s; wrote " << o.out << "/field.txt and report.json\n";
     }
   });
-}
-
-int run_import_quads(const ImportQuadsOptions&, const CommonOptions&) {
-  return not_implemented("import-quads", "#6");
-}
-
-int run_perturb(const PerturbOptions&, const CommonOptions&) {
-  return not_implemented("perturb", "#6");
 }
 
 }  // namespace qs::cli

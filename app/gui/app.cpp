@@ -33,7 +33,9 @@ void glfw_error(int code, const char* message) {
   std::fprintf(stderr, "GLFW error %d: %s\n", code, message);
 }
 
-App* app_of(GLFWwindow* window) { return static_cast<App*>(glfwGetWindowUserPointer(window)); }
+App* app_of(GLFWwindow* window) {
+  return static_cast<App*>(glfwGetWindowUserPointer(window));
+}
 
 void key_callback(GLFWwindow* window, int key, int, int action, int mods) {
   if (App* app = app_of(window)) app->on_key(key, mods, action);
@@ -45,7 +47,8 @@ void drop_callback(GLFWwindow* window, int count, const char** paths) {
 
 std::string lower_extension(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   return ext;
 }
 
@@ -83,7 +86,9 @@ App::App(AppOptions options) : options_(std::move(options)) {
   recent_.load();
 }
 
-App::~App() { shutdown(); }
+App::~App() {
+  shutdown();
+}
 
 void App::on_key(int key, int mods, int action) {
   if (action == GLFW_PRESS || action == GLFW_REPEAT) key_events_.push_back({key, mods});
@@ -273,7 +278,8 @@ void App::poll_worker() {
   SnapshotPtr latest = worker_->latest();
   if (latest->version == snapshot_version_) return;
   snapshot_version_ = latest->version;
-  const bool param_changed = !snapshot_ || snapshot_->corner_uv.size() != latest->corner_uv.size() ||
+  const bool param_changed = !snapshot_ ||
+                             snapshot_->corner_uv.size() != latest->corner_uv.size() ||
                              snapshot_->face_foldover != latest->face_foldover ||
                              snapshot_->iteration != latest->iteration;
   snapshot_ = std::move(latest);
@@ -382,7 +388,8 @@ void App::frame() {
       else if (ext == ".json")
         open_layout(f);
       else
-        report_error("Cannot open " + f + ": expected a mesh (.obj .off .ply .stl) or a layout (.json)");
+        report_error("Cannot open " + f +
+                     ": expected a mesh (.obj .off .ply .stl) or a layout (.json)");
     }
   }
   poll_worker();

@@ -14,7 +14,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path meta_path() { return autosave_dir() / "autosave.meta.json"; }
+fs::path meta_path() {
+  return autosave_dir() / "autosave.meta.json";
+}
 
 std::string absolute_string(const std::string& path) {
   if (path.empty()) return {};
@@ -34,7 +36,9 @@ fs::path autosave_dir() {
   return fs::temp_directory_path() / "quadsketch";
 }
 
-fs::path autosave_path() { return autosave_dir() / "autosave.layout.json"; }
+fs::path autosave_path() {
+  return autosave_dir() / "autosave.layout.json";
+}
 
 void write_autosave(const Layout& layout, const TriMesh* mesh, const std::string& mesh_path,
                     const std::string& layout_path) {

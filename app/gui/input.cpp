@@ -14,7 +14,7 @@ namespace qs::app {
 
 namespace {
 
-constexpr float kClickSlop = 4.0f;    // pixels a click may move before it becomes a drag
+constexpr float kClickSlop = 4.0f;  // pixels a click may move before it becomes a drag
 constexpr float kNodePickPx = 12.0f;
 constexpr float kArcPickPx = 8.0f;
 
@@ -137,7 +137,7 @@ void App::click(const glm::vec2& mouse) {
     case Tool::Select:
       selected_node_ = node;
       selected_arc_ = arc;
-      status_ = node >= 0   ? "Node " + std::to_string(node) + " selected"
+      status_ = node >= 0  ? "Node " + std::to_string(node) + " selected"
                 : arc >= 0 ? "Arc " + std::to_string(arc) + " selected"
                            : "";
       ++interaction_version_;
@@ -236,7 +236,8 @@ void App::handle_mouse() {
   }
 
   switch (drag_) {
-    case Drag::None: break;
+    case Drag::None:
+      break;
     case Drag::Pending:
       if (!ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
         drag_ = Drag::None;
@@ -388,7 +389,19 @@ void App::focus_vertices(const std::vector<int>& vertices) {
     ++count;
   }
   if (count == 0) return;
-  camera_.focus(0.5f * (lo + hi), 0.5f * glm::length(hi - lo));
+  // Look from the side the vertices face (area-weighted normals of their faces).
+  Vec3 normal(0, 0, 0);
+  for (int v : vertices) {
+    if (v < 0 || v >= int(doc_.mesh->n_vertices())) continue;
+    for (auto fh : doc_.mesh->vf_range(OpenMesh::VertexHandle(v))) {
+      auto it = doc_.mesh->cfv_begin(fh);
+      const Vec3 a = doc_.mesh->point(*it++), b = doc_.mesh->point(*it++),
+                 c = doc_.mesh->point(*it);
+      normal += OpenMesh::cross(b - a, c - a);
+    }
+  }
+  camera_.focus(0.5f * (lo + hi), 0.5f * glm::length(hi - lo),
+                glm::vec3(float(normal[0]), float(normal[1]), float(normal[2])));
 }
 
 void App::focus_selection() {
@@ -397,8 +410,7 @@ void App::focus_selection() {
     focus_vertices({layout.nodes[layout.node_index(selected_node_)].vertex});
   } else if (selected_arc_ >= 0 && layout.arc_index(selected_arc_) >= 0) {
     focus_vertices(layout.arcs[layout.arc_index(selected_arc_)].path);
-  } else if (highlighted_issue_ >= 0 &&
-             highlighted_issue_ < int(doc_.validation.issues.size())) {
+  } else if (highlighted_issue_ >= 0 && highlighted_issue_ < int(doc_.validation.issues.size())) {
     focus_vertices(doc_.validation.issues[highlighted_issue_].vertices);
   } else {
     reset_view();

@@ -23,7 +23,9 @@ void clear_node_outputs(LayoutNode& node) {
   node.valence = -1;
 }
 
-bool valid_vertex(const TriMesh& mesh, int v) { return v >= 0 && v < int(mesh.n_vertices()); }
+bool valid_vertex(const TriMesh& mesh, int v) {
+  return v >= 0 && v < int(mesh.n_vertices());
+}
 
 }  // namespace
 
@@ -107,9 +109,9 @@ bool LayoutEditor::reroute_arcs_of(Layout& layout, int node_id, std::string* err
     }
     const RoutingObstacles obstacles = obstacles_of_layout(*mesh_, layout);
     const int source = layout.nodes[from].vertex;
-    std::vector<int> path =
-        arc.dangling() ? shortest_path_to_boundary(*mesh_, source, obstacles)
-                       : shortest_path(*mesh_, source, layout.nodes[to].vertex, obstacles);
+    std::vector<int> path = arc.dangling()
+                                ? shortest_path_to_boundary(*mesh_, source, obstacles)
+                                : shortest_path(*mesh_, source, layout.nodes[to].vertex, obstacles);
     if (path.size() < 2) {
       if (error) *error = "arc " + std::to_string(arc.id) + " cannot be routed (no free path)";
       return false;
@@ -202,8 +204,7 @@ EditResult LayoutEditor::move_node(int id, int vertex) {
   Layout moved = layout_;
   {  // the node's own arcs may pass through the new vertex: they are re-routed anyway
     Layout without_own = layout_;
-    std::erase_if(without_own.arcs,
-                  [&](const LayoutArc& a) { return a.from == id || a.to == id; });
+    std::erase_if(without_own.arcs, [&](const LayoutArc& a) { return a.from == id || a.to == id; });
     if (int arc = arc_through_vertex(without_own, vertex); arc >= 0)
       return EditResult::fail("vertex lies on arc " + std::to_string(arc));
   }
@@ -254,8 +255,7 @@ EditResult LayoutEditor::toggle_node_pin(int id) {
   if (index < 0) return EditResult::fail("unknown node " + std::to_string(id));
   Layout before = layout_;
   layout_.nodes[index].pinned = !layout_.nodes[index].pinned;
-  commit(std::string(layout_.nodes[index].pinned ? "pin" : "unpin") + " node " +
-             std::to_string(id),
+  commit(std::string(layout_.nodes[index].pinned ? "pin" : "unpin") + " node " + std::to_string(id),
          std::move(before));
   return {};
 }
@@ -266,8 +266,7 @@ EditResult LayoutEditor::toggle_arc_pin(int id) {
   if (index < 0) return EditResult::fail("unknown arc " + std::to_string(id));
   Layout before = layout_;
   layout_.arcs[index].pinned = !layout_.arcs[index].pinned;
-  commit(std::string(layout_.arcs[index].pinned ? "pin" : "unpin") + " arc " +
-             std::to_string(id),
+  commit(std::string(layout_.arcs[index].pinned ? "pin" : "unpin") + " arc " + std::to_string(id),
          std::move(before));
   return {};
 }

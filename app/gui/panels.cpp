@@ -20,10 +20,13 @@ const ImVec4 kWarningColor(1.0f, 0.80f, 0.35f, 1.0f);
 const ImVec4 kOkColor(0.45f, 0.85f, 0.50f, 1.0f);
 const ImVec4 kDimColor(0.62f, 0.65f, 0.70f, 1.0f);
 
-ImVec4 to_imvec(const glm::vec3& c) { return ImVec4(c.r, c.g, c.b, 1.0f); }
+ImVec4 to_imvec(const glm::vec3& c) {
+  return ImVec4(c.r, c.g, c.b, 1.0f);
+}
 
 void color_swatch(const char* id, const glm::vec3& color) {
-  ImGui::ColorButton(id, to_imvec(color), ImGuiColorEditFlags_NoTooltip | ImGuiColorEditFlags_NoPicker,
+  ImGui::ColorButton(id, to_imvec(color),
+                     ImGuiColorEditFlags_NoTooltip | ImGuiColorEditFlags_NoPicker,
                      ImVec2(ImGui::GetFontSize(), ImGui::GetFontSize()));
 }
 
@@ -45,24 +48,36 @@ std::string file_name(const std::string& path) {
 
 const char* tool_name(Tool tool) {
   switch (tool) {
-    case Tool::Select: return "Select / move";
-    case Tool::PlaceNode: return "Place node";
-    case Tool::DrawArc: return "Draw arc";
-    case Tool::Split: return "Split arc";
-    case Tool::Delete: return "Delete";
-    case Tool::Pin: return "Pin";
+    case Tool::Select:
+      return "Select / move";
+    case Tool::PlaceNode:
+      return "Place node";
+    case Tool::DrawArc:
+      return "Draw arc";
+    case Tool::Split:
+      return "Split arc";
+    case Tool::Delete:
+      return "Delete";
+    case Tool::Pin:
+      return "Pin";
   }
   return "";
 }
 
 const char* tool_hint(Tool tool) {
   switch (tool) {
-    case Tool::Select: return "Click a node or arc to select it; drag a node to move it.";
-    case Tool::PlaceNode: return "Click the surface to place a node (on an arc: splits it).";
-    case Tool::DrawArc: return "Click a node, then another node: the arc follows the shortest free path.";
-    case Tool::Split: return "Click an arc to split it with a new node.";
-    case Tool::Delete: return "Click a node (with its arcs) or an arc to delete it.";
-    case Tool::Pin: return "Click a node or arc to pin / unpin it.";
+    case Tool::Select:
+      return "Click a node or arc to select it; drag a node to move it.";
+    case Tool::PlaceNode:
+      return "Click the surface to place a node (on an arc: splits it).";
+    case Tool::DrawArc:
+      return "Click a node, then another node: the arc follows the shortest free path.";
+    case Tool::Split:
+      return "Click an arc to split it with a new node.";
+    case Tool::Delete:
+      return "Click a node (with its arcs) or an arc to delete it.";
+    case Tool::Pin:
+      return "Click a node or arc to pin / unpin it.";
   }
   return "";
 }
@@ -83,6 +98,10 @@ void App::draw_main_panel() {
   ImGui::SetNextWindowPos(ImVec2(10.0f, 10.0f), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(width, io.DisplaySize.y - 60.0f), ImGuiCond_FirstUseEver);
   ImGui::Begin("QuadSketch");
+  // Centre the scene in the part of the window the panel leaves free.
+  camera_.set_view_offset(ImGui::IsWindowCollapsed()
+                              ? 0.0f
+                              : 0.5f * (ImGui::GetWindowPos().x + ImGui::GetWindowWidth()));
   draw_files_section();
   draw_tools_section();
   draw_layout_section();
@@ -97,8 +116,8 @@ void App::draw_files_section() {
   ImGui::PushID("files");
   const float button = 4.5f * ImGui::GetFontSize();
   ImGui::SetNextItemWidth(-button);
-  const bool mesh_enter = ImGui::InputTextWithHint("##mesh", "mesh .obj .off .ply .stl", &mesh_field_,
-                                                   ImGuiInputTextFlags_EnterReturnsTrue);
+  const bool mesh_enter = ImGui::InputTextWithHint(
+      "##mesh", "mesh .obj .off .ply .stl", &mesh_field_, ImGuiInputTextFlags_EnterReturnsTrue);
   ImGui::SameLine();
   if (ImGui::Button("Open##mesh", ImVec2(-1, 0)) || mesh_enter) open_mesh(mesh_field_);
   ImGui::SetNextItemWidth(-button);
@@ -141,13 +160,16 @@ void App::draw_files_section() {
   if (!doc_.mesh) ImGui::EndDisabled();
 
   if (doc_.mesh) {
-    ImGui::TextColored(kDimColor, "%s: %d vertices, %d faces, genus %d, %d boundary loop%s",
+    ImGui::PushStyleColor(ImGuiCol_Text, kDimColor);
+    ImGui::TextWrapped("%s: %d vertices, %d faces, genus %d, %d boundary loop%s",
                        file_name(doc_.mesh_path).c_str(), doc_.report.vertices, doc_.report.faces,
                        doc_.report.genus, doc_.report.boundary_loops,
                        doc_.report.boundary_loops == 1 ? "" : "s");
+    ImGui::PopStyleColor();
     ImGui::TextColored(kDimColor, "layout: %s%s", file_name(doc_.layout_path).c_str(),
                        doc_.dirty ? "  (modified, autosaved)" : "");
-    if (!autosave_error_.empty()) ImGui::TextColored(kWarningColor, "autosave failed: %s", autosave_error_.c_str());
+    if (!autosave_error_.empty())
+      ImGui::TextColored(kWarningColor, "autosave failed: %s", autosave_error_.c_str());
   } else {
     ImGui::TextColored(kWarningColor, "No mesh loaded.");
   }
@@ -192,15 +214,15 @@ void App::draw_layout_section() {
     pinned_arcs += a.pinned;
     dangling += a.dangling();
   }
-  if (ImGui::BeginTable("counts", 4, ImGuiTableFlags_SizingStretchSame)) {
+  if (ImGui::BeginTable("counts", 2, ImGuiTableFlags_SizingStretchSame)) {
     ImGui::TableNextColumn();
-    ImGui::Text("nodes %zu", layout.nodes.size());
+    ImGui::Text("%zu nodes", layout.nodes.size());
     ImGui::TableNextColumn();
-    ImGui::Text("arcs %zu", layout.arcs.size());
+    ImGui::Text("%zu arcs", layout.arcs.size());
     ImGui::TableNextColumn();
-    ImGui::Text("irregular %d", irregular);
+    ImGui::Text("%d irregular nodes", irregular);
     ImGui::TableNextColumn();
-    ImGui::Text("pinned %d", pinned_nodes + pinned_arcs);
+    ImGui::Text("%d pinned", pinned_nodes + pinned_arcs);
     ImGui::EndTable();
   }
   if (dangling > 0 || !layout.patches.empty())
@@ -234,7 +256,8 @@ void App::draw_validation_section() {
     ImGui::TextColored(kOkColor, "The layout is valid.");
     return;
   }
-  const float height = std::min(10.0f, float(v.issues.size()) + 0.5f) * ImGui::GetTextLineHeightWithSpacing();
+  const float height =
+      std::min(10.0f, float(v.issues.size()) + 0.5f) * ImGui::GetTextLineHeightWithSpacing();
   ImGui::BeginChild("issues", ImVec2(0, height), true);
   for (int i = 0; i < int(v.issues.size()); ++i) {
     const auto& issue = v.issues[i];
@@ -283,7 +306,7 @@ void App::draw_pipeline_section() {
   if (!has_mesh) ImGui::EndDisabled();
   if (!snapshot_) return;
   const Snapshot& s = *snapshot_;
-  const ImVec4 color = s.status == WorkerStatus::Failed ? kErrorColor
+  const ImVec4 color = s.status == WorkerStatus::Failed     ? kErrorColor
                        : s.status == WorkerStatus::Finished ? kOkColor
                                                             : kDimColor;
   ImGui::TextColored(color, "%s", to_string(s.status));
@@ -387,8 +410,8 @@ void App::draw_error_panel() {
 void App::draw_autosave_prompt() {
   if (!autosave_offer_) return;
   const ImGuiIO& io = ImGui::GetIO();
-  ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x * 0.5f, io.DisplaySize.y * 0.4f), ImGuiCond_Always,
-                          ImVec2(0.5f, 0.5f));
+  ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x * 0.5f, io.DisplaySize.y * 0.4f),
+                          ImGuiCond_Always, ImVec2(0.5f, 0.5f));
   ImGui::Begin("Restore autosave?", nullptr,
                ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoCollapse |
                    ImGuiWindowFlags_NoSavedSettings);

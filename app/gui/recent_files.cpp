@@ -57,7 +57,11 @@ void RecentFiles::add(std::vector<std::string>& list, const std::string& path) {
   if (list.size() > max_entries) list.resize(max_entries);
 }
 
-void RecentFiles::add_mesh(const std::string& path) { add(meshes_, path); }
-void RecentFiles::add_layout(const std::string& path) { add(layouts_, path); }
+void RecentFiles::add_mesh(const std::string& path) {
+  add(meshes_, path);
+}
+void RecentFiles::add_layout(const std::string& path) {
+  add(layouts_, path);
+}
 
 }  // namespace qs::app

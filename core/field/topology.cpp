@@ -151,10 +151,12 @@ struct CycleEquation {
   bool ok = false;
 };
 
+CycleEquation path_equation(const TriMesh& mesh, const GeometryCache& g, const std::vector<int>& path,
+                            long sectors_term, const std::string& name);
+
 CycleEquation cycle_equation(const TriMesh& mesh, const GeometryCache& g, const Layout& layout,
                              const LayoutTopology& topo,
                              const std::vector<std::pair<int, bool>>& cycle) {
-  CycleEquation eq;
   // Closed vertex path and the half-arcs at each node.
   std::vector<int> path;
   long sectors_term = 0;  // Σ (2 − s_i)
@@ -178,6 +180,13 @@ CycleEquation cycle_equation(const TriMesh& mesh, const GeometryCache& g, const 
     const int s = ((pos_in - pos_out) % val + val) % val;
     sectors_term += 2 - s;
   }
+  return path_equation(mesh, g, path, sectors_term, "layout cycle (arcs " + arc_list(layout, cycle) + ")");
+}
+
+// Σ_Γ p = sectors_term − 4W for the closed vertex path, Γ its left face strip (§1.3).
+CycleEquation path_equation(const TriMesh& mesh, const GeometryCache& g, const std::vector<int>& path,
+                            long sectors_term, const std::string& name) {
+  CycleEquation eq;
   const int len = static_cast<int>(path.size());
   double kappa_sum = 0, angle_term = 0;
   for (int k = 0; k < len; ++k) {
@@ -213,8 +222,7 @@ CycleEquation cycle_equation(const TriMesh& mesh, const GeometryCache& g, const 
   const double W = (kappa_sum + angle_term) / (2 * M_PI);
   const long Wi = std::lround(W);
   if (std::abs(W - Wi) > 1e-6) {
-    throw QsError("internal error: non-integral winding " + std::to_string(W) +
-                  " along layout cycle (arcs " + arc_list(layout, cycle) + ")");
+    throw QsError("internal error: non-integral winding " + std::to_string(W) + " along " + name);
   }
   eq.rhs = sectors_term - 4 * Wi;
   eq.ok = true;
@@ -392,6 +400,46 @@ std::vector<int> compute_period_jumps(const TriMesh& mesh, const GeometryCache& 
     row_cycle.push_back(static_cast<int>(c));
   }
   rep.cycles = static_cast<int>(rows.size());
+  // Boundary loops that no layout cycle determines (holes that dangling arcs run into, with
+  // no closed arc cycle around them): the field turns like the loop's tangent there, i.e. the
+  // loop itself is a cycle without corners. Added only where it raises the rank, so it never
+  // overrides what the layout implies.
+  auto rank_of = [&](const std::vector<std::vector<long>>& R) {
+    if (R.empty() || nfree == 0) return 0;
+    Eigen::MatrixXd A(R.size(), nfree);
+    for (size_t r = 0; r < R.size(); ++r)
+      for (int k = 0; k < nfree; ++k) A(r, k) = static_cast<double>(R[r][k]);
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
+    qr.setThreshold(1e-9);
+    return static_cast<int>(qr.rank());
+  };
+  if (nfree > 0 && rank_of(rows) < nfree) {
+    std::vector<char> node_vertex(nv, 0);
+    for (const auto& n : layout.nodes) node_vertex[n.vertex] = 1;
+    int current = rank_of(rows);
+    for (int l = 0; l < nb && current < nfree; ++l) {
+      bool has_node = false;
+      for (int v : loops[l]) has_node |= node_vertex[v] != 0;
+      if (has_node) continue;
+      CycleEquation eq = path_equation(mesh, g, loops[l], 0, "boundary loop " + std::to_string(l));
+      if (!eq.ok) continue;
+      std::vector<long> row(nfree, 0);
+      long b = eq.rhs;
+      for (auto [e, s] : eq.terms) {
+        b -= s * p[e].c;
+        for (int k = 0; k < nfree; ++k) row[k] += s * p[e].coef[k];
+      }
+      rows.push_back(row);
+      if (rank_of(rows) > current) {
+        ++current;
+        rhs.push_back(b);
+        row_cycle.push_back(-1 - l);
+        ++rep.boundary_loop_equations;
+      } else {
+        rows.pop_back();
+      }
+    }
+  }
   if (nfree > 0) {
     Eigen::MatrixXd A(rows.size(), nfree);
     Eigen::VectorXd B(rows.size());

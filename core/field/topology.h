@@ -19,6 +19,7 @@ struct PeriodJumpReport {
   int cycles = 0;          //!< layout cycles used
   int cycles_skipped = 0;  //!< cycles through the boundary that cannot carry a left strip
   int rank = 0;            //!< rank of the cycle system in the free unknowns
+  int boundary_loop_equations = 0;  //!< undetermined holes fixed to turn like their boundary
   int max_abs_jump = 0;
 };
 

@@ -123,6 +123,8 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
                          const std::vector<double>& theta, const ParamOptions& options)
     : options_(options), period_jump_(p) {
   const auto t0 = std::chrono::steady_clock::now();
+  if (!options_.face_weights.empty() && static_cast<int>(options_.face_weights.size()) != g.n_faces)
+    throw InvalidInputError("ParamOptions::face_weights must have one entry per face");
   std::vector<char> singular(g.n_vertices, 0);
   for (int n = 0; n < topo.num_nodes; ++n)
     if (topo.valence[n] != 4) singular[layout.nodes[n].vertex] = 1;
@@ -257,6 +259,7 @@ const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCa
     Eigen::Matrix<double, 2, 3> G;
     double area;
     face_gradients(mesh, g, f, G, area);
+    if (!options_.face_weights.empty()) area *= options_.face_weights[f];
     const Eigen::Vector2d u(std::cos(theta[f]), std::sin(theta[f])), v(-u.y(), u.x());
     const Eigen::Matrix2d Wu = u * u.transpose() + aniso * v * v.transpose();
     const Eigen::Matrix2d Wv = v * v.transpose() + aniso * u * u.transpose();

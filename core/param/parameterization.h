@@ -20,6 +20,9 @@ struct ParamOptions {
   //! Anisotropic norm (BZK09): misalignment is penalised `anisotropy` times more than scale.
   bool anisotropic = true;
   double anisotropy = 10.0;
+  //! Per-face weights w_t multiplying each face's term of (1) (stiffening, algorithm.md §7.1).
+  //! Empty (the default) means all 1; otherwise size #F, every entry > 0.
+  std::vector<double> face_weights;
 };
 
 struct ParamTimings {
@@ -33,7 +36,8 @@ struct ParamTimings {
 struct Parameterization {
   //! (u, v) per face corner, size 3·#F, corner k of face f at 3f + k (GeometryCache order).
   std::vector<std::array<double, 2>> corner_uv;
-  double energy = 0;  //!< E: value of energy (1) at the solution (length² units)
+  double energy = 0;  //!< E: value of energy (1) at the solution (length² units), weighted by
+                      //!< ParamOptions::face_weights when they are set
   int foldovers = 0;  //!< faces with signed parametric area ≤ 0
   // Diagnostics.
   int wedges = 0, cut_edges = 0, constraint_rows = 0, eliminated = 0, redundant = 0, unknowns = 0;

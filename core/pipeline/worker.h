@@ -21,6 +21,7 @@
 #include <thread>
 #include <variant>
 
+#include "core/base/progress.h"
 #include "core/layout/layout.h"
 #include "core/mesh/mesh.h"
 #include "core/pipeline/snapshot.h"
@@ -35,15 +36,16 @@ struct WorkerOptions {
   double quad_size = 0.0;  //!< 0: automatic
 };
 
-//! What a step function sees of the job. Lives on the worker thread only.
-class WorkerObserver {
+//! What a step function sees of the job: a qs::Observer, so it can be handed straight to
+//! the pipeline stages. Lives on the worker thread only.
+class WorkerObserver : public Observer {
  public:
   WorkerObserver(const std::atomic<std::uint64_t>& generation, std::uint64_t job_generation,
                  std::stop_token stop)
       : generation_(generation), job_generation_(job_generation), stop_(std::move(stop)) {}
   //! True when the job was superseded (LoadMesh, Stop) or the worker shuts down. Core code
   //! checks it between solves and throws Cancelled.
-  bool should_cancel() const {
+  bool should_cancel() const override {
     return stop_.stop_requested() || generation_.load(std::memory_order_acquire) != job_generation_;
   }
   //! Throws Cancelled when should_cancel().

@@ -1,0 +1,698 @@
+#include "core/layout/quad_import.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <sstream>
+#include <string>
+
+#include "core/base/errors.h"
+#include "core/layout/path_finder.h"
+#include "core/layout/routing.h"
+#include "core/layout/validate.h"
+#include "core/mesh/closest_point.h"
+
+namespace qs {
+
+namespace {
+
+using HH = OpenMesh::HalfedgeHandle;
+using VH = OpenMesh::VertexHandle;
+
+std::string join_ids(const std::vector<int>& ids, size_t max_count = 20) {
+  std::ostringstream ss;
+  for (size_t i = 0; i < ids.size() && i < max_count; ++i) ss << (i ? ", " : "") << ids[i];
+  if (ids.size() > max_count) ss << ", ... (" << ids.size() << " in all)";
+  return ss.str();
+}
+
+std::string format_length(double d) {
+  std::ostringstream ss;
+  ss.precision(3);
+  ss << d;
+  return ss.str();
+}
+
+// Index of the lattice point at parameter t (0..k) along halfedge h of the quad mesh.
+int edge_lattice_vertex(const PolyMesh& quads, int k, HH h, int t) {
+  if (t == 0) return quads.from_vertex_handle(h).idx();
+  if (t == k) return quads.to_vertex_handle(h).idx();
+  const auto e = quads.edge_handle(h);
+  const int along = h == quads.halfedge_handle(e, 0) ? t : k - t;
+  return static_cast<int>(quads.n_vertices()) + e.idx() * (k - 1) + (along - 1);
+}
+
+void require_pure_quad(const PolyMesh& quads) {
+  for (const auto f : quads.faces()) {
+    if (quads.valence(f) != 4) {
+      throw InvalidInputError("face " + std::to_string(f.idx()) + " has " +
+                              std::to_string(quads.valence(f)) + " vertices; expected quads only");
+    }
+  }
+}
+
+// Mean edge length and bounding-box diagonal.
+template <typename MeshT>
+std::pair<double, double> mesh_scales(const MeshT& mesh) {
+  double sum = 0;
+  for (const auto e : mesh.edges()) sum += mesh.calc_edge_length(e);
+  const double mean = mesh.n_edges() ? sum / mesh.n_edges() : 0.0;
+  const double inf = std::numeric_limits<double>::infinity();
+  Vec3 lo(inf, inf, inf), hi(-inf, -inf, -inf);
+  for (const auto v : mesh.vertices()) {
+    lo.minimize(mesh.point(v));
+    hi.maximize(mesh.point(v));
+  }
+  return {mean, mesh.n_vertices() ? (hi - lo).norm() : 0.0};
+}
+
+// Throws with every validation error of a layout produced here.
+void require_valid(const TriMesh& mesh, const Layout& layout, const std::string& what) {
+  const ValidationResult result = validate_layout(mesh, layout);
+  if (result.valid()) return;
+  std::string msg =
+      what + " is not a valid layout (" + std::to_string(result.errors()) + " error(s)):";
+  int shown = 0;
+  for (const auto& issue : result.issues) {
+    if (issue.severity != IssueSeverity::Error) continue;
+    if (++shown > 12) {
+      msg += "\n  ...";
+      break;
+    }
+    msg += "\n  " + format_issue(issue);
+  }
+  throw InvalidInputError(msg);
+}
+
+// True when the sequences are equal up to a cyclic rotation.
+bool same_cycle(const std::vector<int>& a, const std::vector<int>& b) {
+  if (a.size() != b.size()) return false;
+  if (a.empty()) return true;
+  for (size_t shift = 0; shift < b.size(); ++shift) {
+    if (b[shift] != a[0]) continue;
+    bool equal = true;
+    for (size_t i = 0; i < a.size() && equal; ++i) equal = a[i] == b[(i + shift) % b.size()];
+    if (equal) return true;
+  }
+  return false;
+}
+
+// Routes a quad complex onto a target triangle mesh (see transfer_complex).
+class Transfer {
+ public:
+  Transfer(const PolyMesh& quads, const QuadComplex& complex, const TriMesh& target,
+           const QuadImportOptions& options)
+      : quads_(quads),
+        complex_(complex),
+        target_(target),
+        options_(options),
+        tree_(target),
+        finder_(target) {
+    std::tie(mean_edge_, diagonal_) = mesh_scales(target);
+    max_distance_ = options.max_distance_fraction * diagonal_;
+    const size_t nv = target.n_vertices();
+    obstacles_.vertex_blocked.assign(nv, 0);
+    obstacles_.edge_blocked.assign(target.n_edges(), 0);
+    allowed_.assign(nv, 0);
+    cost_.assign(nv, 1.0);
+    curve_distance_.assign(nv, std::numeric_limits<double>::infinity());
+    visit_stamp_.assign(nv, 0);
+    exit_owner_.assign(nv, -1);
+  }
+
+  Layout run() {
+    Layout layout;
+    layout.mesh_vertices = static_cast<int>(target_.n_vertices());
+    layout.mesh_faces = static_cast<int>(target_.n_faces());
+    place_nodes(layout);
+    route_arcs(layout);
+    require_valid(target_, layout, "the transferred layout");
+    check_cyclic_orders(layout);
+    return layout;
+  }
+
+ private:
+  struct Sample {
+    Vec3 point;  // on the target surface
+    int face = -1;
+  };
+
+  void place_nodes(Layout& layout) {
+    const int n_nodes = static_cast<int>(complex_.node_vertex.size());
+    std::vector<int> far, stuck;
+    std::vector<std::string> far_text;
+    node_target_vertex_.assign(n_nodes, -1);
+    for (int n = 0; n < n_nodes; ++n) {
+      const VH qv(complex_.node_vertex[n]);
+      const ClosestPoint cp = tree_.closest(quads_.point(qv));
+      if (cp.face < 0 || cp.distance > max_distance_) {
+        far.push_back(n);
+        far_text.push_back("node " + std::to_string(n) + " (quad vertex " +
+                           std::to_string(qv.idx()) + ") is " + format_length(cp.distance) +
+                           " away");
+        continue;
+      }
+      const int v = snap_node(cp, quads_.is_boundary(qv));
+      if (v < 0) {
+        stuck.push_back(n);
+        continue;
+      }
+      node_target_vertex_[n] = v;
+      obstacles_.vertex_blocked[v] = 1;
+    }
+    if (!far.empty()) {
+      std::string msg =
+          "the quad mesh does not lie on the target mesh: " + std::to_string(far.size()) +
+          " node(s) are farther than " + format_length(max_distance_) + " (" +
+          format_length(100 * options_.max_distance_fraction) +
+          "% of its bounding-box diagonal) from its surface: ";
+      for (size_t i = 0; i < far_text.size() && i < 10; ++i) msg += (i ? "; " : "") + far_text[i];
+      if (far_text.size() > 10) msg += "; ...";
+      throw InvalidInputError(msg);
+    }
+    if (!stuck.empty()) {
+      throw InvalidInputError(
+          "nodes " + join_ids(stuck) +
+          " found no free target vertex near their position (other nodes took them, or a "
+          "boundary node has no boundary vertex nearby); the target mesh is too coarse for "
+          "this layout (" +
+          std::to_string(n_nodes) + " nodes, " + std::to_string(complex_.arcs.size()) +
+          " arcs; the target mesh has " + std::to_string(target_.n_vertices()) + " vertices)");
+    }
+    for (int n = 0; n < n_nodes; ++n) {
+      LayoutNode node;
+      node.id = n;
+      node.vertex = node_target_vertex_[n];
+      layout.nodes.push_back(node);
+    }
+    reserve_exits();
+  }
+
+  // Nearest free vertex of the closest face, else of that face's 1-ring.
+  int snap_node(const ClosestPoint& cp, bool boundary) {
+    std::vector<int> candidates;
+    for (const auto v : target_.fv_range(OpenMesh::FaceHandle(cp.face))) {
+      candidates.push_back(v.idx());
+      for (const auto w : target_.vv_range(v)) candidates.push_back(w.idx());
+    }
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    std::stable_sort(candidates.begin(), candidates.end(), [&](int a, int b) {
+      return (target_.point(VH(a)) - cp.point).sqrnorm() <
+             (target_.point(VH(b)) - cp.point).sqrnorm();
+    });
+    for (int v : candidates) {
+      if (obstacles_.vertex_blocked[v]) continue;
+      if (boundary != target_.is_boundary(VH(v))) continue;
+      return v;
+    }
+    return -1;
+  }
+
+  // Point of the source arc at arc length \p length from the node end of half-arc \p half.
+  Vec3 point_along(int half, double length) const {
+    const auto& p = complex_.arcs[half >> 1].path;
+    auto at = [&](size_t i) { return quads_.point(VH((half & 1) ? p[p.size() - 1 - i] : p[i])); };
+    double walked = 0;
+    for (size_t i = 0; i + 1 < p.size(); ++i) {
+      const Vec3 a = at(i), b = at(i + 1);
+      const double l = (b - a).norm();
+      if (walked + l >= length && l > 0) return a + (b - a) * ((length - walked) / l);
+      walked += l;
+    }
+    return at(p.size() - 1);
+  }
+
+  // Area-weighted normal of a vertex (works for polygons too: Newell's cross products).
+  template <typename MeshT>
+  static Vec3 vertex_normal(const MeshT& mesh, VH v) {
+    Vec3 n(0, 0, 0);
+    for (const auto f : mesh.vf_range(v)) {
+      Vec3 fn(0, 0, 0);
+      for (const auto h : mesh.fh_range(f)) {
+        const Vec3& a = mesh.point(mesh.from_vertex_handle(h));
+        const Vec3& b = mesh.point(mesh.to_vertex_handle(h));
+        fn += OpenMesh::cross(a, b);
+      }
+      n += fn;
+    }
+    return n;
+  }
+
+  // Chooses, for every half-arc, the neighbour of its node's target vertex through which it
+  // leaves: distinct per node, in the source's cyclic order (a cyclic monotone assignment
+  // minimising the squared distance to the source arc one target edge away from the node).
+  // Reserved exits are blocked for every other arc, so no arc can seal off a node.
+  void reserve_exits() {
+    const int n_nodes = static_cast<int>(complex_.node_vertex.size());
+    exit_.assign(2 * complex_.arcs.size(), -1);
+    double agreement = 0;
+    for (int n = 0; n < n_nodes; ++n) {
+      agreement += OpenMesh::dot(vertex_normal(quads_, VH(complex_.node_vertex[n])),
+                                 vertex_normal(target_, VH(node_target_vertex_[n])));
+    }
+    reversed_ = agreement < 0;
+    std::vector<int> node_of_vertex(target_.n_vertices(), -1);
+    for (int n = 0; n < n_nodes; ++n) node_of_vertex[node_target_vertex_[n]] = n;
+    std::vector<int> stuck;
+    const double inf = std::numeric_limits<double>::infinity();
+    for (int n = 0; n < n_nodes; ++n) {
+      const int t = node_target_vertex_[n];
+      std::vector<int> ring;
+      double reach = 0;
+      for (const auto h : target_.voh_ccw_range(VH(t))) {
+        ring.push_back(target_.to_vertex_handle(h).idx());
+        reach += target_.calc_edge_length(h);
+      }
+      std::vector<int> halves = complex_.node_half_arcs[n];
+      if (reversed_) std::reverse(halves.begin(), halves.end());
+      const int k = static_cast<int>(halves.size()), m = static_cast<int>(ring.size());
+      if (k == 0) continue;
+      if (k > m) {
+        stuck.push_back(n);
+        continue;
+      }
+      reach /= m;
+      std::vector<double> cost(k * m, inf);
+      for (int i = 0; i < k; ++i) {
+        const int h = halves[i];
+        const int arc = h >> 1;
+        const auto& qa = complex_.arcs[arc];
+        const int other_node = (h & 1) ? qa.from : qa.to;
+        const int other_vertex = node_target_vertex_[other_node];
+        const int other_exit = exit_[h ^ 1];
+        const bool boundary_arc = is_boundary_arc(qa);
+        const Vec3 wanted = point_along(h, reach);
+        for (int j = 0; j < m; ++j) {
+          const int w = ring[j];
+          const auto e = target_.edge_handle(target_.find_halfedge(VH(t), VH(w)));
+          if (boundary_arc != target_.is_boundary(e)) continue;
+          if (!boundary_arc && target_.is_boundary(VH(w)) && node_of_vertex[w] < 0) continue;
+          if (other_exit == t && w != other_vertex) continue;  // the other end took the edge
+          if (node_of_vertex[w] >= 0) {
+            if (w != other_vertex || other_node == n) continue;
+            if (other_exit >= 0 && other_exit != t) continue;
+          } else if (exit_owner_[w] >= 0 && exit_owner_[w] != (h ^ 1)) {
+            continue;
+          }
+          cost[i * m + j] = (target_.point(VH(w)) - wanted).sqrnorm();
+        }
+      }
+      // Cyclic monotone assignment: for each rotation of the ring, a DP over (half, neighbour).
+      double best = inf;
+      std::vector<int> best_choice;
+      std::vector<double> f((k + 1) * (m + 1));
+      std::vector<char> take((k + 1) * (m + 1));
+      for (int r = 0; r < m; ++r) {
+        for (int j = 0; j <= m; ++j) f[j] = 0;
+        for (int i = 1; i <= k; ++i) {
+          f[i * (m + 1)] = inf;
+          for (int j = 1; j <= m; ++j) {
+            const double skip = f[i * (m + 1) + j - 1];
+            const double use = f[(i - 1) * (m + 1) + j - 1] + cost[(i - 1) * m + (j - 1 + r) % m];
+            take[i * (m + 1) + j] = use < skip;
+            f[i * (m + 1) + j] = std::min(use, skip);
+          }
+        }
+        if (f[k * (m + 1) + m] < best) {
+          best = f[k * (m + 1) + m];
+          best_choice.assign(k, -1);
+          for (int i = k, j = m; i > 0; --j) {
+            if (take[i * (m + 1) + j]) best_choice[--i] = ring[(j - 1 + r) % m];
+          }
+        }
+      }
+      if (!(best < inf)) {
+        stuck.push_back(n);
+        continue;
+      }
+      for (int i = 0; i < k; ++i) {
+        const int w = best_choice[i];
+        exit_[halves[i]] = w;
+        if (node_of_vertex[w] < 0) {
+          exit_owner_[w] = halves[i];
+          obstacles_.vertex_blocked[w] = 1;
+        }
+      }
+    }
+    if (!stuck.empty()) {
+      throw InvalidInputError(
+          "nodes " + join_ids(stuck) +
+          " cannot keep their arcs in order on the target mesh: their target vertices have too "
+          "few free neighbours (the target mesh is too coarse for this layout near them)");
+    }
+  }
+
+  // Routes arc a: node vertex, its reserved exit, a corridor path to the other exit, node.
+  std::vector<int> route_between_exits(int a, const std::vector<Sample>& samples, bool boundary) {
+    const auto& arc = complex_.arcs[a];
+    const int s = node_target_vertex_[arc.from], t = node_target_vertex_[arc.to];
+    const int out = exit_[2 * a], in = exit_[2 * a + 1];
+    if (out == t) return {s, t};
+    if (out == in) return {s, out, t};
+    double radius = options_.corridor_radius * mean_edge_;
+    std::vector<int> middle;
+    for (int attempt = 0; attempt <= options_.corridor_growths && middle.empty(); ++attempt) {
+      build_corridor(samples, radius, boundary);
+      middle = finder_.find(out, in, obstacles_, &allowed_, &cost_);
+      radius *= 2;
+    }
+    clear_corridor();
+    if (middle.empty()) return {};
+    middle.insert(middle.begin(), s);
+    middle.push_back(t);
+    return middle;
+  }
+
+  // Closest-point projections of the source arc, at most half a target edge apart.
+  std::vector<Sample> sample_arc(const QuadComplex::Arc& arc, double& worst_distance) {
+    std::vector<Sample> samples;
+    worst_distance = 0;
+    const double spacing = 0.5 * mean_edge_;
+    Vec3 last(std::numeric_limits<double>::infinity(), 0, 0);
+    auto add = [&](const Vec3& q, bool force) {
+      if (!force && (q - last).norm() < 0.5 * spacing) return;
+      last = q;
+      const ClosestPoint cp = tree_.closest(q);
+      worst_distance = std::max(worst_distance, cp.distance);
+      samples.push_back({cp.point, cp.face});
+    };
+    const auto& p = arc.path;
+    for (size_t k = 0; k + 1 < p.size(); ++k) {
+      const Vec3 a = quads_.point(VH(p[k])), b = quads_.point(VH(p[k + 1]));
+      const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / spacing)));
+      for (int s = 0; s < steps; ++s) add(a + (b - a) * (static_cast<double>(s) / steps), k == 0);
+    }
+    add(quads_.point(VH(p.back())), true);
+    return samples;
+  }
+
+  bool is_boundary_arc(const QuadComplex::Arc& arc) const {
+    for (size_t k = 0; k + 1 < arc.path.size(); ++k) {
+      const HH h = quads_.find_halfedge(VH(arc.path[k]), VH(arc.path[k + 1]));
+      if (!quads_.is_boundary(quads_.edge_handle(h))) return false;
+    }
+    return true;
+  }
+
+  // Marks the vertices within \p radius of the samples (grown over mesh edges from each
+  // sample's face) as allowed, with a cost growing with the distance from the curve.
+  void build_corridor(const std::vector<Sample>& samples, double radius, bool boundary_only) {
+    clear_corridor();
+    std::vector<int> queue;
+    for (const Sample& s : samples) {
+      ++stamp_;
+      queue.clear();
+      for (const auto v : target_.fv_range(OpenMesh::FaceHandle(s.face))) {
+        visit_stamp_[v.idx()] = stamp_;
+        queue.push_back(v.idx());
+      }
+      for (size_t head = 0; head < queue.size(); ++head) {
+        const int v = queue[head];
+        const double d = (target_.point(VH(v)) - s.point).norm();
+        if (curve_distance_[v] == std::numeric_limits<double>::infinity()) corridor_.push_back(v);
+        curve_distance_[v] = std::min(curve_distance_[v], d);
+        for (const auto w : target_.vv_range(VH(v))) {
+          if (visit_stamp_[w.idx()] == stamp_) continue;
+          visit_stamp_[w.idx()] = stamp_;
+          if ((target_.point(w) - s.point).norm() <= radius) queue.push_back(w.idx());
+        }
+      }
+    }
+    for (int v : corridor_) {
+      allowed_[v] = !boundary_only || target_.is_boundary(VH(v));
+      // Interior arcs must not touch the boundary (it belongs to the boundary arcs).
+      if (!boundary_only && target_.is_boundary(VH(v))) allowed_[v] = 0;
+      const double x = curve_distance_[v] / mean_edge_;
+      cost_[v] = 1.0 + 2.0 * x * x;
+    }
+  }
+
+  void clear_corridor() {
+    for (int v : corridor_) {
+      allowed_[v] = 0;
+      cost_[v] = 1.0;
+      curve_distance_[v] = std::numeric_limits<double>::infinity();
+    }
+    corridor_.clear();
+  }
+
+  void block_path(const std::vector<int>& path) {
+    for (size_t k = 0; k < path.size(); ++k) {
+      obstacles_.vertex_blocked[path[k]] = 1;
+      if (k == 0) continue;
+      const auto h = target_.find_halfedge(VH(path[k - 1]), VH(path[k]));
+      obstacles_.edge_blocked[target_.edge_handle(h).idx()] = 1;
+    }
+  }
+
+  void route_arcs(Layout& layout) {
+    const int n_arcs = static_cast<int>(complex_.arcs.size());
+    std::vector<double> length(n_arcs, 0);
+    std::vector<char> boundary(n_arcs, 0);
+    for (int a = 0; a < n_arcs; ++a) {
+      const auto& p = complex_.arcs[a].path;
+      for (size_t k = 0; k + 1 < p.size(); ++k)
+        length[a] += (quads_.point(VH(p[k + 1])) - quads_.point(VH(p[k]))).norm();
+      boundary[a] = is_boundary_arc(complex_.arcs[a]);
+    }
+    std::vector<int> order(n_arcs);
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+      if (boundary[a] != boundary[b]) return boundary[a] > boundary[b];
+      return length[a] < length[b];
+    });
+
+    std::vector<std::vector<int>> paths(n_arcs);
+    std::vector<int> failed, far;
+    for (int a : order) {
+      const auto& arc = complex_.arcs[a];
+      double worst = 0;
+      const std::vector<Sample> samples = sample_arc(arc, worst);
+      if (worst > max_distance_) {
+        far.push_back(a);
+        continue;
+      }
+      paths[a] = route_between_exits(a, samples, boundary[a] != 0);
+      clear_corridor();
+      if (paths[a].empty()) {
+        failed.push_back(a);
+        continue;
+      }
+      block_path(paths[a]);
+    }
+    if (!far.empty()) {
+      throw InvalidInputError("the quad mesh does not lie on the target mesh: arcs " +
+                              join_ids(far) + " pass farther than " + format_length(max_distance_) +
+                              " from its surface");
+    }
+    if (!failed.empty()) {
+      std::sort(failed.begin(), failed.end());
+      throw InvalidInputError(
+          "cannot route arcs " + join_ids(failed) +
+          " onto the target mesh: no edge path near the source arc avoids the arcs routed "
+          "before (the target mesh may be too coarse for this layout)");
+    }
+    for (int a = 0; a < n_arcs; ++a) {
+      LayoutArc arc;
+      arc.id = a;
+      arc.from = complex_.arcs[a].from;
+      arc.to = complex_.arcs[a].to;
+      arc.path = std::move(paths[a]);
+      layout.arcs.push_back(std::move(arc));
+    }
+  }
+
+  void check_cyclic_orders(const Layout& layout) {
+    const LayoutTopology topo = build_topology(target_, layout);
+    std::vector<int> bad;
+    for (size_t n = 0; n < complex_.node_vertex.size(); ++n) {
+      std::vector<int> expected = complex_.node_half_arcs[n];
+      // A target oriented against the quad mesh reverses every order; that is fine.
+      if (reversed_) std::reverse(expected.begin(), expected.end());
+      if (!same_cycle(expected, topo.node_half_arcs[n])) bad.push_back(static_cast<int>(n));
+    }
+    if (!bad.empty()) {
+      throw InvalidInputError(
+          "the transferred layout changes the cyclic order of the arcs at nodes " + join_ids(bad));
+    }
+  }
+
+  const PolyMesh& quads_;
+  const QuadComplex& complex_;
+  const TriMesh& target_;
+  const QuadImportOptions& options_;
+  ClosestPointTree tree_;
+  PathFinder finder_;
+  double mean_edge_ = 0, diagonal_ = 0, max_distance_ = 0;
+  RoutingObstacles obstacles_;
+  std::vector<int> node_target_vertex_;
+  // Corridor state (reset per arc through corridor_).
+  std::vector<char> allowed_;
+  std::vector<double> cost_;
+  std::vector<double> curve_distance_;
+  std::vector<int> corridor_;
+  std::vector<int> visit_stamp_;
+  int stamp_ = 0;
+  // Per half-arc: the target vertex next to its node through which it must leave (the other
+  // end's node vertex for a direct edge). Per vertex: the half-arc that reserved it, or -1.
+  std::vector<int> exit_;
+  std::vector<int> exit_owner_;
+  bool reversed_ = false;  // the target is oriented against the quad mesh
+};
+
+}  // namespace
+
+TriMesh triangulate_quads(const PolyMesh& quads, int refine) {
+  if (refine < 1) {
+    throw InvalidInputError("refine must be at least 1 (got " + std::to_string(refine) + ")");
+  }
+  require_pure_quad(quads);
+  const int k = refine;
+  const int nqv = static_cast<int>(quads.n_vertices());
+  const int ne = static_cast<int>(quads.n_edges());
+  const int nf = static_cast<int>(quads.n_faces());
+  TriMesh mesh;
+  for (const auto v : quads.vertices()) mesh.add_vertex(quads.point(v));
+  for (const auto e : quads.edges()) {
+    const HH h = quads.halfedge_handle(e, 0);
+    const Vec3 a = quads.point(quads.from_vertex_handle(h)),
+               b = quads.point(quads.to_vertex_handle(h));
+    for (int t = 1; t < k; ++t) mesh.add_vertex(a + (b - a) * (static_cast<double>(t) / k));
+  }
+  const int face_base = nqv + ne * (k - 1);
+  std::vector<int> lattice((k + 1) * (k + 1));
+  for (const auto f : quads.faces()) {
+    HH h[4];
+    h[0] = quads.halfedge_handle(f);
+    for (int s = 1; s < 4; ++s) h[s] = quads.next_halfedge_handle(h[s - 1]);
+    Vec3 c[4];
+    for (int s = 0; s < 4; ++s) c[s] = quads.point(quads.from_vertex_handle(h[s]));
+    // Local lattice (i, j): (0,0) = c0, (k,0) = c1, (k,k) = c2, (0,k) = c3; the four sides
+    // are h0..h3 in order, so the cells keep the quad's orientation.
+    auto at = [&](int i, int j) -> int& { return lattice[j * (k + 1) + i]; };
+    for (int t = 0; t <= k; ++t) {
+      at(t, 0) = edge_lattice_vertex(quads, k, h[0], t);
+      at(k, t) = edge_lattice_vertex(quads, k, h[1], t);
+      at(k - t, k) = edge_lattice_vertex(quads, k, h[2], t);
+      at(0, k - t) = edge_lattice_vertex(quads, k, h[3], t);
+    }
+    for (int j = 1; j < k; ++j) {
+      for (int i = 1; i < k; ++i) {
+        const double s = static_cast<double>(i) / k, r = static_cast<double>(j) / k;
+        const Vec3 p =
+            (1 - s) * (1 - r) * c[0] + s * (1 - r) * c[1] + s * r * c[2] + (1 - s) * r * c[3];
+        const int id = face_base + f.idx() * (k - 1) * (k - 1) + (j - 1) * (k - 1) + (i - 1);
+        mesh.add_vertex(p);
+        at(i, j) = id;
+      }
+    }
+    for (int j = 0; j < k; ++j) {
+      for (int i = 0; i < k; ++i) {
+        const VH a(at(i, j)), b(at(i + 1, j)), cc(at(i + 1, j + 1)), d(at(i, j + 1));
+        const double ac = (mesh.point(a) - mesh.point(cc)).sqrnorm();
+        const double bd = (mesh.point(b) - mesh.point(d)).sqrnorm();
+        if (ac <= bd) {
+          mesh.add_face(a, b, cc);
+          mesh.add_face(a, cc, d);
+        } else {
+          mesh.add_face(a, b, d);
+          mesh.add_face(b, cc, d);
+        }
+      }
+    }
+  }
+  if (static_cast<int>(mesh.n_faces()) != 2 * k * k * nf) {
+    throw InvalidInputError("the quad mesh could not be triangulated: " +
+                            std::to_string(2 * k * k * nf - static_cast<int>(mesh.n_faces())) +
+                            " triangles were refused (non-manifold or inconsistently oriented "
+                            "quads)");
+  }
+  return mesh;
+}
+
+std::vector<int> refine_quad_path(const PolyMesh& quads, int refine, const std::vector<int>& path) {
+  std::vector<int> out;
+  if (path.empty()) return out;
+  out.push_back(path[0]);
+  for (size_t i = 0; i + 1 < path.size(); ++i) {
+    const HH h = quads.find_halfedge(VH(path[i]), VH(path[i + 1]));
+    for (int t = 1; t <= refine; ++t) out.push_back(edge_lattice_vertex(quads, refine, h, t));
+  }
+  return out;
+}
+
+Layout layout_on_triangulation(const PolyMesh& quads, const QuadComplex& complex, int refine) {
+  Layout layout;
+  for (size_t n = 0; n < complex.node_vertex.size(); ++n) {
+    LayoutNode node;
+    node.id = static_cast<int>(n);
+    node.vertex = complex.node_vertex[n];
+    layout.nodes.push_back(node);
+  }
+  for (size_t a = 0; a < complex.arcs.size(); ++a) {
+    LayoutArc arc;
+    arc.id = static_cast<int>(a);
+    arc.from = complex.arcs[a].from;
+    arc.to = complex.arcs[a].to;
+    arc.path = refine_quad_path(quads, refine, complex.arcs[a].path);
+    layout.arcs.push_back(std::move(arc));
+  }
+  return layout;
+}
+
+Layout transfer_complex(const PolyMesh& quads, const QuadComplex& complex, const TriMesh& target,
+                        const QuadImportOptions& options) {
+  if (target.n_faces() == 0) throw InvalidInputError("the target mesh has no faces");
+  return Transfer(quads, complex, target, options).run();
+}
+
+QuadImportResult import_quads(const PolyMesh& quads, const TriMesh* target,
+                              const QuadImportOptions& options) {
+  QuadImportResult result;
+  if (is_pure_quad(quads)) {
+    result.quads = quads;
+  } else {
+    std::vector<int> counts(8, 0);
+    int other = 0;
+    for (const auto f : quads.faces()) {
+      const size_t n = quads.valence(f);
+      if (n < counts.size())
+        ++counts[n];
+      else
+        ++other;
+    }
+    std::string mix;
+    for (size_t n = 3; n < counts.size(); ++n) {
+      if (counts[n] && n != 4)
+        mix += (mix.empty() ? "" : ", ") + std::to_string(counts[n]) + " with " +
+               std::to_string(n) + " sides";
+    }
+    if (other) mix += (mix.empty() ? "" : ", ") + std::to_string(other) + " with more sides";
+    result.warnings.push_back("the mesh is not pure quad (" + mix +
+                              "): split every face once into quads (face centroid + edge "
+                              "midpoints, Catmull-Clark-style, no smoothing)");
+    result.quads = split_to_quads(quads);
+    result.split = true;
+  }
+  BaseComplexOptions bc;
+  bc.all_edges = options.all_edges;
+  result.complex = base_complex(result.quads, bc);
+  if (target) {
+    if (options.refine != 1) {
+      result.warnings.push_back("--refine is ignored when transferring onto another mesh");
+    }
+    result.mesh = *target;
+    result.layout = transfer_complex(result.quads, result.complex, *target, options);
+  } else {
+    result.mesh = triangulate_quads(result.quads, options.refine);
+    result.layout = layout_on_triangulation(result.quads, result.complex, options.refine);
+    result.layout.mesh_vertices = static_cast<int>(result.mesh.n_vertices());
+    result.layout.mesh_faces = static_cast<int>(result.mesh.n_faces());
+    require_valid(result.mesh, result.layout, "the base complex of the quad mesh");
+  }
+  return result;
+}
+
+}  // namespace qs

@@ -1,0 +1,78 @@
+// Importing a quad mesh's patch layout (its base complex, or all its edges) as a Layout on a
+// triangle mesh: the triangulated quad mesh itself (exact), or another triangle mesh onto
+// which the layout is transferred (issue #6).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/layout/base_complex.h"
+#include "core/layout/layout.h"
+#include "core/mesh/mesh.h"
+
+namespace qs {
+
+struct QuadImportOptions {
+  //! Every edge is an arc and every vertex a node (coarse cages) instead of the base complex.
+  bool all_edges = false;
+  //! Without a target mesh: split every quad refine × refine (bilinearly) before triangulating.
+  //! Ignored with a target mesh.
+  int refine = 1;
+  //! With a target mesh: a node or arc sample farther than this fraction of the target's
+  //! bounding-box diagonal from its surface is an error.
+  double max_distance_fraction = 0.05;
+  //! With a target mesh: initial corridor radius around each projected source arc, in mean edge
+  //! lengths of the target.
+  double corridor_radius = 2.5;
+  //! With a target mesh: how often a failed arc is retried with the corridor radius doubled.
+  int corridor_growths = 3;
+};
+
+struct QuadImportResult {
+  TriMesh mesh;         //!< the triangle mesh the layout lives on
+  Layout layout;        //!< node i / arc a have id i / a (QuadComplex order)
+  PolyMesh quads;       //!< the quad mesh used (after the split of non-quad faces, if any)
+  QuadComplex complex;  //!< the layout on \p quads
+  bool split = false;   //!< non-quad faces were split (split_to_quads)
+  std::vector<std::string> warnings;
+};
+
+//! Triangulates a pure quad mesh, each quad first split refine × refine by bilinear
+//! interpolation of its corners, each small quad then cut along its shorter diagonal.
+//! Vertex order: the quad mesh's vertices (same indices), then refine − 1 points per edge (edge
+//! order, running from the edge's first halfedge's from-vertex), then (refine − 1)² per face
+//! (face order, row by row). Neighbouring quads share their edge points. 2·refine² triangles
+//! per quad, in quad order.
+//! \pre is_pure_quad(quads); refine >= 1. \throw InvalidInputError otherwise.
+TriMesh triangulate_quads(const PolyMesh& quads, int refine = 1);
+
+//! The vertex path on triangulate_quads(quads, refine) that runs along the quad-mesh vertex
+//! path \p path (each quad edge becomes refine mesh edges).
+//! \pre consecutive vertices of \p path are joined by quad-mesh edges.
+std::vector<int> refine_quad_path(const PolyMesh& quads, int refine, const std::vector<int>& path);
+
+//! The complex as a Layout on triangulate_quads(quads, refine): exact, no projection.
+Layout layout_on_triangulation(const PolyMesh& quads, const QuadComplex& complex, int refine);
+
+//! Transfers the complex onto another triangle mesh \p target lying near the quad mesh:
+//! nodes go to the closest surface point of \p target, snapped to the nearest free vertex of
+//! its face (or of that face's 1-ring; boundary nodes only to boundary vertices); arcs are
+//! routed along \p target's edges by a shortest path restricted to a corridor around the
+//! closest-point projection of the densely sampled source arc (cost grows with the distance
+//! from the projected curve), avoiding the arcs routed before (boundary arcs first, then by
+//! increasing length) and other nodes. The result must validate (validate_layout) and keep
+//! every node's cyclic order of arcs.
+//! \throw InvalidInputError naming the nodes/arcs farther than
+//!        options.max_distance_fraction · bbox diagonal, nodes that find no free vertex, the
+//!        arcs that could not be routed, validation issues, or nodes whose cyclic order changed.
+Layout transfer_complex(const PolyMesh& quads, const QuadComplex& complex, const TriMesh& target,
+                        const QuadImportOptions& options = {});
+
+//! Whole import: splits non-quad faces once (with a warning), computes the base complex (or
+//! all edges), then builds the layout on the triangulated quad mesh (\p target == nullptr) or
+//! on \p target (transfer_complex).
+//! \throw InvalidInputError as base_complex, triangulate_quads and transfer_complex.
+QuadImportResult import_quads(const PolyMesh& quads, const TriMesh* target,
+                              const QuadImportOptions& options = {});
+
+}  // namespace qs

@@ -1,0 +1,209 @@
+// Tests of the base complex of quad meshes (core/layout/base_complex.h).
+#include "core/layout/base_complex.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <map>
+
+#include "core/base/errors.h"
+#include "core/mesh/mesh_io.h"
+#include "tests/fixtures.h"
+
+namespace qs {
+namespace {
+
+using VH = OpenMesh::VertexHandle;
+
+//! Surface of the cube [0,k]^3 as a k×k quad grid per side, outward oriented.
+PolyMesh quad_cube(int k) {
+  PolyMesh mesh;
+  std::map<std::array<int, 3>, VH> lattice;
+  auto vertex = [&](std::array<int, 3> p) {
+    auto it = lattice.find(p);
+    if (it != lattice.end()) return it->second;
+    const VH v = mesh.add_vertex(Vec3(p[0], p[1], p[2]));
+    lattice.emplace(p, v);
+    return v;
+  };
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int side : {0, k}) {
+      // Tangent axes (b, c) with b × c = +axis; swapped on the negative side.
+      int b = (axis + 1) % 3, c = (axis + 2) % 3;
+      if (side == 0) std::swap(b, c);
+      for (int i = 0; i < k; ++i) {
+        for (int j = 0; j < k; ++j) {
+          std::array<int, 3> p{};
+          p[axis] = side;
+          auto at = [&](int di, int dj) {
+            std::array<int, 3> q = p;
+            q[b] = i + di;
+            q[c] = j + dj;
+            return vertex(q);
+          };
+          mesh.add_face(std::vector<VH>{at(0, 0), at(1, 0), at(1, 1), at(0, 1)});
+        }
+      }
+    }
+  }
+  return mesh;
+}
+
+//! nu × nv quad grid on a torus (no irregular vertex).
+PolyMesh quad_torus(int nu, int nv) {
+  PolyMesh mesh;
+  for (int i = 0; i < nu; ++i) {
+    for (int j = 0; j < nv; ++j) {
+      const double t = 2 * M_PI * i / nu, f = 2 * M_PI * j / nv;
+      mesh.add_vertex(Vec3((2 + 0.7 * std::cos(f)) * std::cos(t),
+                           (2 + 0.7 * std::cos(f)) * std::sin(t), 0.7 * std::sin(f)));
+    }
+  }
+  auto id = [&](int i, int j) { return VH(((i + nu) % nu) * nv + (j + nv) % nv); };
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j)
+      mesh.add_face(std::vector<VH>{id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+  return mesh;
+}
+
+//! Flat nx × ny quad grid (a disk); its 4 corners have valence 2.
+PolyMesh quad_disk(int nx, int ny) {
+  PolyMesh mesh;
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) mesh.add_vertex(Vec3(i, j, 0));
+  auto id = [&](int i, int j) { return VH(j * (nx + 1) + i); };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i)
+      mesh.add_face(std::vector<VH>{id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+  return mesh;
+}
+
+TEST(BaseComplex, CubeHasEightCornersTwelveArcsSixPatches) {
+  for (int k : {1, 2, 5}) {
+    const PolyMesh cube = quad_cube(k);
+    ASSERT_EQ(cube.n_faces(), static_cast<size_t>(6 * k * k));
+    const QuadComplex qc = base_complex(cube);
+    EXPECT_EQ(qc.irregular_vertices, 8);
+    EXPECT_EQ(qc.node_vertex.size(), 8u) << "k = " << k;
+    EXPECT_EQ(qc.arcs.size(), 12u);
+    EXPECT_EQ(qc.num_patches, 6);
+    for (int v : qc.valence) EXPECT_EQ(v, 3);
+    for (const auto& arc : qc.arcs) {
+      EXPECT_EQ(arc.path.size(), static_cast<size_t>(k + 1));
+      EXPECT_EQ(arc.path.front(), qc.node_vertex[arc.from]);
+      EXPECT_EQ(arc.path.back(), qc.node_vertex[arc.to]);
+    }
+  }
+}
+
+TEST(BaseComplex, DiskGridIsOnePatch) {
+  // The corners (boundary valence 2) are the only irregular vertices; their separatrices run
+  // along the boundary, so the complex is the boundary rectangle.
+  const QuadComplex disk = base_complex(quad_disk(4, 3));
+  EXPECT_EQ(disk.node_vertex.size(), 4u);  // the corners
+  EXPECT_EQ(disk.arcs.size(), 4u);         // the four sides
+  EXPECT_EQ(disk.num_patches, 1);
+  for (int v : disk.valence) EXPECT_EQ(v, 2);
+}
+
+TEST(BaseComplex, NoIrregularVertexNeedsAllEdges) {
+  const PolyMesh torus = quad_torus(6, 4);
+  try {
+    base_complex(torus);
+    FAIL() << "expected InvalidInputError";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--all-edges"), std::string::npos) << e.what();
+  }
+  BaseComplexOptions options;
+  options.all_edges = true;
+  const QuadComplex qc = base_complex(torus, options);
+  EXPECT_EQ(qc.node_vertex.size(), 24u);
+  EXPECT_EQ(qc.arcs.size(), 48u);
+  EXPECT_EQ(qc.num_patches, 24);
+  for (int v : qc.valence) EXPECT_EQ(v, 4);
+}
+
+TEST(BaseComplex, AllEdgesOnCube) {
+  BaseComplexOptions options;
+  options.all_edges = true;
+  const PolyMesh cube = quad_cube(2);
+  const QuadComplex qc = base_complex(cube, options);
+  EXPECT_EQ(qc.node_vertex.size(), cube.n_vertices());
+  EXPECT_EQ(qc.arcs.size(), cube.n_edges());
+  EXPECT_EQ(qc.num_patches, static_cast<int>(cube.n_faces()));
+}
+
+TEST(BaseComplex, HalfArcOrderIsCounterClockwise) {
+  // At the corner (0,0,0) of the cube the three arcs go to +x, +y, +z; seen from outside
+  // (from (-1,-1,-1)) the counter-clockwise order is x, z, y.
+  const PolyMesh cube = quad_cube(1);
+  const QuadComplex qc = base_complex(cube);
+  int origin = -1;
+  for (size_t n = 0; n < qc.node_vertex.size(); ++n)
+    if (cube.point(VH(qc.node_vertex[n])).sqrnorm() == 0) origin = static_cast<int>(n);
+  ASSERT_GE(origin, 0);
+  std::vector<int> axis_order;
+  for (int h : qc.node_half_arcs[origin]) {
+    const auto& arc = qc.arcs[h >> 1];
+    const int far = (h & 1) ? arc.path[arc.path.size() - 2] : arc.path[1];
+    const Vec3 d = cube.point(VH(far));
+    axis_order.push_back(d[0] > 0 ? 0 : d[1] > 0 ? 1 : 2);
+  }
+  ASSERT_EQ(axis_order.size(), 3u);
+  std::rotate(axis_order.begin(), std::find(axis_order.begin(), axis_order.end(), 0),
+              axis_order.end());
+  EXPECT_EQ(axis_order, (std::vector<int>{0, 2, 1}));
+}
+
+TEST(BaseComplex, SplitToQuadsKeepsOriginalVertices) {
+  PolyMesh mesh;
+  // A pyramid: square base and 4 triangles.
+  std::vector<VH> v;
+  for (const Vec3& p : {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)})
+    v.push_back(mesh.add_vertex(p));
+  v.push_back(mesh.add_vertex(Vec3(0.5, 0.5, 1)));
+  mesh.add_face(std::vector<VH>{v[3], v[2], v[1], v[0]});
+  for (int i = 0; i < 4; ++i) mesh.add_face(v[i], v[(i + 1) % 4], v[4]);
+  EXPECT_FALSE(is_pure_quad(mesh));
+  const PolyMesh quads = split_to_quads(mesh);
+  EXPECT_TRUE(is_pure_quad(quads));
+  EXPECT_EQ(quads.n_faces(), 4u + 4 * 3);
+  EXPECT_EQ(quads.n_vertices(), mesh.n_vertices() + mesh.n_edges() + mesh.n_faces());
+  for (const auto vh : mesh.vertices()) EXPECT_EQ(quads.point(vh), mesh.point(vh));
+  // Corners of the pyramid: the apex (valence 4 before, still 4) is regular; the base corners
+  // have valence 3: 4 irregular + 5 face centres (valence 4 for the square, 3 for triangles).
+  const QuadComplex qc = base_complex(quads);
+  EXPECT_EQ(qc.irregular_vertices, 8);
+}
+
+TEST(BaseComplex, RealQuadMeshes) {
+  const std::string dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real quad meshes skipped";
+  struct Case {
+    std::string file;
+    int irregular;
+  };
+  // Irregular-vertex counts from ../shared/data/SOURCES.md (boundary corners included).
+  for (const Case& c :
+       {Case{"spot/spot_quadrangulated.obj", 100}, Case{"fandisk/fandisk_quads.off", 30},
+        Case{"quadwild_joint/joint_rem_p_quadrangulation.obj", 46},
+        Case{"animals_basemesh/cat_cat.obj", 370}}) {
+    const PolyMesh quads = load_poly_mesh(dir + "/" + c.file);
+    const QuadComplex qc = base_complex(quads);
+    EXPECT_EQ(qc.irregular_vertices, c.irregular) << c.file;
+    // Closed surfaces: V - E + F of the complex equals that of the quad mesh.
+    const int chi = static_cast<int>(quads.n_vertices()) - static_cast<int>(quads.n_edges()) +
+                    static_cast<int>(quads.n_faces());
+    EXPECT_EQ(
+        static_cast<int>(qc.node_vertex.size()) - static_cast<int>(qc.arcs.size()) + qc.num_patches,
+        chi)
+        << c.file;
+    int irregular_nodes = 0;
+    for (int v : qc.valence) irregular_nodes += v != 4;
+    EXPECT_EQ(irregular_nodes, c.irregular) << c.file;
+  }
+}
+
+}  // namespace
+}  // namespace qs

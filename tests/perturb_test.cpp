@@ -1,0 +1,194 @@
+// Tests of layout perturbation (core/layout/perturb.h) and `quadsketch-cli perturb`.
+#include "core/layout/perturb.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <filesystem>
+#include <map>
+
+#include "core/base/atomic_file.h"
+#include "core/base/errors.h"
+#include "core/layout/layout_io.h"
+#include "core/layout/quad_import.h"
+#include "core/layout/validate.h"
+#include "core/mesh/mesh_io.h"
+#include "tests/fixtures.h"
+
+namespace qs {
+namespace {
+
+using VH = OpenMesh::VertexHandle;
+
+//! Surface of the cube [0,k]^3 as a k×k quad grid per side, outward oriented.
+PolyMesh quad_cube(int k) {
+  PolyMesh mesh;
+  std::map<std::array<int, 3>, VH> lattice;
+  auto vertex = [&](std::array<int, 3> p) {
+    auto it = lattice.find(p);
+    if (it != lattice.end()) return it->second;
+    const VH v = mesh.add_vertex(Vec3(p[0], p[1], p[2]));
+    lattice.emplace(p, v);
+    return v;
+  };
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int side : {0, k}) {
+      int b = (axis + 1) % 3, c = (axis + 2) % 3;
+      if (side == 0) std::swap(b, c);
+      for (int i = 0; i < k; ++i) {
+        for (int j = 0; j < k; ++j) {
+          std::array<int, 3> p{};
+          p[axis] = side;
+          auto at = [&](int di, int dj) {
+            std::array<int, 3> q = p;
+            q[b] = i + di;
+            q[c] = j + dj;
+            return vertex(q);
+          };
+          mesh.add_face(std::vector<VH>{at(0, 0), at(1, 0), at(1, 1), at(0, 1)});
+        }
+      }
+    }
+  }
+  return mesh;
+}
+
+//! Breadth-first edge distance between two vertices.
+int ring_distance(const TriMesh& mesh, int a, int b) {
+  std::vector<int> dist(mesh.n_vertices(), -1);
+  std::vector<int> queue{a};
+  dist[a] = 0;
+  for (size_t head = 0; head < queue.size(); ++head) {
+    const int v = queue[head];
+    if (v == b) return dist[v];
+    for (const auto w : mesh.vv_range(VH(v))) {
+      if (dist[w.idx()] < 0) {
+        dist[w.idx()] = dist[v] + 1;
+        queue.push_back(w.idx());
+      }
+    }
+  }
+  return -1;
+}
+
+//! Cyclic arc-id orders per node, each rotated to start at its smallest half-arc.
+std::vector<std::vector<int>> cyclic_orders(const TriMesh& mesh, const Layout& layout) {
+  const LayoutTopology topo = build_topology(mesh, layout);
+  std::vector<std::vector<int>> out;
+  for (auto list : topo.node_half_arcs) {
+    if (!list.empty())
+      std::rotate(list.begin(), std::min_element(list.begin(), list.end()), list.end());
+    out.push_back(list);
+  }
+  return out;
+}
+
+void expect_valid_same_structure(const TriMesh& mesh, const Layout& before, const Layout& after) {
+  const ValidationResult vr = validate_layout(mesh, after);
+  ASSERT_TRUE(vr.valid()) << (vr.issues.empty() ? "" : format_issue(vr.issues[0]));
+  EXPECT_EQ(build_topology(mesh, before).patches.size(),
+            build_topology(mesh, after).patches.size());
+  EXPECT_EQ(cyclic_orders(mesh, before), cyclic_orders(mesh, after));
+}
+
+QuadImportResult refined_cube(int k, int refine) {
+  QuadImportOptions options;
+  options.refine = refine;
+  return import_quads(quad_cube(k), nullptr, options);
+}
+
+TEST(Perturb, CubeNodesMoveByTheRequestedRings) {
+  const QuadImportResult r = refined_cube(2, 4);  // arcs of 8 edges
+  for (int rings : {1, 2, 3}) {
+    PerturbLayoutOptions options;
+    options.rings = rings;
+    options.seed = 7;
+    const PerturbResult p = perturb_layout(r.mesh, r.layout, options);
+    expect_valid_same_structure(r.mesh, r.layout, p.layout);
+    EXPECT_EQ(p.moved_nodes.size() + p.stuck_nodes.size(), r.layout.nodes.size());
+    EXPECT_GE(p.moved_nodes.size(), r.layout.nodes.size() / 2) << "rings " << rings;
+    for (int id : p.moved_nodes) {
+      const int n = r.layout.node_index(id);
+      EXPECT_EQ(ring_distance(r.mesh, r.layout.nodes[n].vertex, p.layout.nodes[n].vertex), rings);
+    }
+    for (int id : p.stuck_nodes) {
+      const int n = r.layout.node_index(id);
+      EXPECT_EQ(r.layout.nodes[n].vertex, p.layout.nodes[n].vertex);
+    }
+  }
+}
+
+TEST(Perturb, SameSeedSameResult) {
+  const QuadImportResult r = refined_cube(2, 4);
+  PerturbLayoutOptions options;
+  options.rings = 2;
+  options.seed = 42;
+  const std::string a = layout_to_json(perturb_layout(r.mesh, r.layout, options).layout);
+  const std::string b = layout_to_json(perturb_layout(r.mesh, r.layout, options).layout);
+  EXPECT_EQ(a, b);
+  options.seed = 43;
+  const std::string c = layout_to_json(perturb_layout(r.mesh, r.layout, options).layout);
+  EXPECT_NE(a, c);
+}
+
+TEST(Perturb, PinnedNodesStay) {
+  QuadImportResult r = refined_cube(2, 4);
+  r.layout.nodes[0].pinned = true;
+  PerturbLayoutOptions options;
+  options.rings = 1;
+  const PerturbResult p = perturb_layout(r.mesh, r.layout, options);
+  EXPECT_EQ(p.layout.nodes[0].vertex, r.layout.nodes[0].vertex);
+  EXPECT_EQ(p.pinned_nodes, std::vector<int>{r.layout.nodes[0].id});
+}
+
+TEST(Perturb, InvalidLayoutOrRingsAreErrors) {
+  QuadImportResult r = refined_cube(1, 3);
+  PerturbLayoutOptions options;
+  options.rings = 0;
+  EXPECT_THROW(perturb_layout(r.mesh, r.layout, options), InvalidInputError);
+  options.rings = 1;
+  r.layout.arcs.pop_back();  // leaves a patch with a missing side
+  EXPECT_THROW(perturb_layout(r.mesh, r.layout, options), InvalidInputError);
+}
+
+TEST(Perturb, RealSpotRefined) {
+  const std::string dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
+  QuadImportOptions io;
+  io.refine = 3;
+  const QuadImportResult r =
+      import_quads(load_poly_mesh(dir + "/spot/spot_quadrangulated.obj"), nullptr, io);
+  PerturbLayoutOptions options;
+  options.rings = 2;
+  options.seed = 1;
+  const PerturbResult p = perturb_layout(r.mesh, r.layout, options);
+  expect_valid_same_structure(r.mesh, r.layout, p.layout);
+  EXPECT_GE(p.moved_nodes.size(), r.layout.nodes.size() * 3 / 4);
+  for (int id : p.moved_nodes) {
+    const int n = r.layout.node_index(id);
+    EXPECT_EQ(ring_distance(r.mesh, r.layout.nodes[n].vertex, p.layout.nodes[n].vertex), 2);
+  }
+}
+
+TEST(PerturbCli, WritesAValidLayout) {
+  const std::string dir = test::temp_dir("perturb_cli");
+  const QuadImportResult r = refined_cube(2, 4);
+  test::write_obj(r.mesh, dir + "/mesh.obj");
+  save_layout(r.layout, dir + "/layout.json", &r.mesh);
+  std::string output;
+  const std::string cmd = test::cli_path() + " perturb --mesh " + dir + "/mesh.obj --layout " +
+                          dir + "/layout.json --rings 2 --seed 5 --out ";
+  ASSERT_EQ(test::run_command(cmd + dir + "/p1.json", &output), 0) << output;
+  ASSERT_EQ(test::run_command(cmd + dir + "/p2.json", &output), 0) << output;
+  EXPECT_EQ(read_file(dir + "/p1.json"), read_file(dir + "/p2.json"));
+  ASSERT_EQ(test::run_command(test::cli_path() + " validate --mesh " + dir + "/mesh.obj --layout " +
+                                  dir + "/p1.json",
+                              &output),
+            0)
+      << output;
+  EXPECT_NE(read_file(dir + "/p1.json"), read_file(dir + "/layout.json"));
+}
+
+}  // namespace
+}  // namespace qs
