@@ -50,6 +50,12 @@ void MeshLayer::upload(const SceneData& data) {
         }
       }
       corners_ = static_cast<int>(buffer.size() / 6);
+      // Parameter units are world units: about 3 mesh edges per checker cell makes the
+      // iso-lines readable at any model scale.
+      double edge_sum = 0;
+      for (auto eh : mesh.edges()) edge_sum += mesh.calc_edge_length(eh);
+      if (mesh.n_edges() > 0 && edge_sum > 0)
+        checker_scale = float(mesh.n_edges() / (3.0 * edge_sum));
       geometry_.upload(buffer.data(), buffer.size() * sizeof(float));
       vao_.attribute(0, geometry_, 3, 6, 0);
       vao_.attribute(1, geometry_, 3, 6, 3);
@@ -107,7 +113,7 @@ void MeshLayer::ui() {
   ImGui::Checkbox("UV checker", &checker);
   ImGui::SameLine();
   ImGui::Checkbox("Fold-overs", &show_foldovers);
-  ImGui::SliderFloat("Checker scale", &checker_scale, 0.05f, 20.0f, "%.2f",
+  ImGui::SliderFloat("Checker scale", &checker_scale, 0.01f, 1000.0f, "%.3g",
                      ImGuiSliderFlags_Logarithmic);
   if (!has_uv_) {
     ImGui::EndDisabled();

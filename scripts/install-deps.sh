@@ -12,6 +12,8 @@ PACKAGES=(
   coinor-libipopt-dev
   libgl-dev libegl-dev libopengl-dev libgl1-mesa-dri libegl-mesa0 mesa-utils
   xvfb xauth
+  assimp-utils
+  clang libclang-rt-14-dev
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

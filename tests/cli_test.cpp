@@ -19,7 +19,8 @@ namespace {
 namespace fs = std::filesystem;
 
 const std::string kMesh = test::assets_dir() + "/example/ellipsoid.obj";
-const std::string kLayout = test::assets_dir() + "/example/ellipsoid.layout.json";
+const std::string kLayout = test::assets_dir() + "/example/ellipsoid.layout.json";  // the sketch
+const std::string kExact = test::assets_dir() + "/example/ellipsoid_exact.layout.json";
 
 std::string cli(const std::string& args) {
   return test::cli_path() + " " + args;
@@ -147,8 +148,8 @@ TEST(Cli, FieldWritesSingularitiesAndDirections) {
 TEST(Cli, OptimizeWithoutNodeOptimizationWritesEverything) {
   const std::string dir = test::temp_dir("cli_optimize");
   std::string out;
-  ASSERT_EQ(test::run_command(cli("optimize --no-node-opt --mesh " + kMesh + " --layout " +
-                                  kLayout + " --out " + dir),
+  ASSERT_EQ(test::run_command(cli("optimize --no-node-opt --mesh " + kMesh + " --layout " + kExact +
+                                  " --out " + dir),
                               &out),
             0)
       << out;
@@ -190,6 +191,34 @@ TEST(Cli, OptimizeWithoutNodeOptimizationWritesEverything) {
     EXPECT_EQ(p.nodes.size(), 4u);
     EXPECT_GT(p.size[0], 0);
     EXPECT_GT(p.size[1], 0);
+  }
+}
+
+TEST(Cli, OptimizeMovesTheSketchedNodesAndRemovesFoldovers) {
+  // The bundled sketch has nodes 3 rings off; with fixed nodes its parameterization folds.
+  const std::string fixed = test::temp_dir("cli_fixed"), moved = test::temp_dir("cli_moved");
+  std::string out;
+  ASSERT_EQ(test::run_command(cli("optimize --no-node-opt --quiet --mesh " + kMesh + " --layout " +
+                                  kLayout + " --out " + fixed),
+                              &out),
+            0)
+      << out;
+  ASSERT_EQ(test::run_command(cli("optimize --quiet --mesh " + kMesh + " --layout " + kLayout +
+                                  " --out " + moved),
+                              &out),
+            0)
+      << out;
+  const auto before = read_json(fixed + "/report.json"), after = read_json(moved + "/report.json");
+  EXPECT_GT(before["metrics"]["foldovers"].get<int>(), 0);
+  EXPECT_EQ(after["metrics"]["foldovers"].get<int>(), 0);
+  EXPECT_TRUE(after["structurally_equivalent"].get<bool>());
+  EXPECT_LT(after["E_final"].get<double>(), 0.5 * after["E_init"].get<double>());
+  ASSERT_GT(after["steps"].size(), 0u);
+  double previous = after["E_init"].get<double>();
+  for (const auto& step : after["steps"]) {
+    if (!step["accepted"].get<bool>() || step["phase"] != "descent") continue;
+    EXPECT_LE(step["E"].get<double>(), previous * (1 + 1e-12));
+    previous = step["E"].get<double>();
   }
 }
 

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "app/cli/commands.h"
+#include "app/cli/signals.h"
 #include "core/base/errors.h"
 
 int main(int argc, char** argv) {
@@ -13,6 +14,7 @@ int main(int argc, char** argv) {
                "quadsketch-cli"};
   app.set_version_flag("--version", std::string("quadsketch-cli ") + QS_VERSION);
   app.require_subcommand(1);
+  app.fallthrough();  // global flags such as --quiet also work after the subcommand
   CommonOptions common;
   app.add_flag("-q,--quiet", common.quiet, "Silence progress output");
 
@@ -41,7 +43,14 @@ int main(int argc, char** argv) {
   cmd_opt->add_option("--steps", opt.steps, "Maximum number of node optimization steps")
       ->capture_default_str();
   cmd_opt->add_flag("--no-node-opt", opt.no_node_opt, "Only field and parameterization");
-  cmd_opt->add_option("--quad-size", opt.quad_size, "Write quads.obj with this quad size");
+  auto* quad_size_opt = cmd_opt->add_option(
+      "--quad-size", opt.quad_size,
+      "Write quads.obj, patches.json, layout_curves.obj with this quad size");
+  cmd_opt
+      ->add_option("--quad-count", opt.quad_count,
+                   "Like --quad-size, choosing the size for about N quads")
+      ->check(CLI::PositiveNumber)
+      ->excludes(quad_size_opt);
   cmd_opt->add_option("--gradient", opt.gradient, "Node gradient: estimator or exact")
       ->check(CLI::IsMember({"estimator", "exact"}))
       ->capture_default_str();
@@ -79,12 +88,16 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : 1;
   }
 
+  install_signal_handlers();  // SIGINT/SIGTERM: cancel, report.json "cancelled", 130/143
   try {
     if (*cmd_validate) return run_validate(validate, common);
     if (*cmd_field) return run_field(field, common);
     if (*cmd_opt) return run_optimize(opt, common);
     if (*cmd_import) return run_import_quads(imp, common);
     if (*cmd_perturb) return run_perturb(perturb, common);
+  } catch (const qs::Cancelled&) {
+    std::cerr << "error: cancelled (" << signal_name(received_signal()) << ")\n";
+    return cancelled_exit_code();
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return qs::exit_code_for(e);

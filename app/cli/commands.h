@@ -24,6 +24,7 @@ struct OptimizeOptions {
   int steps = 25;
   bool no_node_opt = false;
   double quad_size = 0.0;
+  int quad_count = 0;  //!< alternative to quad_size: about this many quads
   std::string gradient = "estimator";
   bool no_align = false;
   bool discrete_relocation = false;

@@ -4,9 +4,12 @@
 #include <chrono>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
+#include "app/cli/signals.h"
 #include "core/base/atomic_file.h"
+#include "core/base/errors.h"
 #include "core/layout/layout.h"
 #include "core/mesh/mesh_io.h"
 
@@ -33,18 +36,35 @@ inline nlohmann::json layout_json(const LayoutTopology& topo) {
 }
 
 //! Runs a command that writes into an output folder: report.json is written also on failure,
-//! with "status": "failed" and the message, before the error propagates.
+//! with "status": "failed" and the message, before the error propagates. On SIGINT/SIGTERM
+//! (signals.h) the status is "cancelled" and qs::Cancelled propagates (exit code 128 + signal);
+//! a stage that does not poll for cancellation is stopped by a CancelWatchdog.
 template <typename Body>
 int with_report(const std::string& out_dir, Body&& body) {
   std::filesystem::create_directories(out_dir);
   const std::string report_path = (std::filesystem::path(out_dir) / "report.json").string();
   nlohmann::json report;
+  std::optional<CancelWatchdog> watchdog(std::in_place, out_dir);
   try {
+    cancellation_point();
     body(report);
+    watchdog.reset();
+    cancellation_point();
     report["status"] = "ok";
     write_file_atomic(report_path, report.dump(2) + "\n");
     return 0;
+  } catch (const Cancelled&) {
+    watchdog.reset();  // the report below is the last write
+    report["status"] = "cancelled";
+    report["signal"] = signal_name(received_signal());
+    report["message"] = "interrupted by " + signal_name(received_signal());
+    try {
+      write_file_atomic(report_path, report.dump(2) + "\n");
+    } catch (...) {
+    }
+    throw;
   } catch (const std::exception& e) {
+    watchdog.reset();
     report["status"] = "failed";
     report["message"] = e.what();
     try {

@@ -81,7 +81,7 @@ void apply_style(float scale) {
 }  // namespace
 
 App::App(AppOptions options) : options_(std::move(options)) {
-  worker_ = std::make_unique<Worker>(placeholder_pipeline_step);
+  worker_ = std::make_unique<Worker>(pipeline_step);
   doc_.editor.on_change = [this](const Layout& layout) { on_layout_edited(layout); };
   recent_.load();
 }
@@ -273,6 +273,12 @@ void App::shutdown() {
   }
 }
 
+bool App::job_layout_shown() const {
+  return snapshot_ && snapshot_->mesh == doc_.mesh && snapshot_->iteration > 0 &&
+         snapshot_->layout && snapshot_->status != WorkerStatus::Failed &&
+         snapshot_->status != WorkerStatus::Idle;
+}
+
 void App::poll_worker() {
   // Copy the pointer under the worker's lock; use the immutable snapshot lock-free after.
   SnapshotPtr latest = worker_->latest();
@@ -426,6 +432,11 @@ void App::render_scene(int fb_width, int fb_height) {
   scene.mesh_version = doc_.mesh_version;
   scene.layout = &doc_.editor.layout();
   scene.layout_version = doc_.editor.version();
+  if (job_layout_shown()) {
+    // While a job's result is current, show its layout: traced iso-lines, moved nodes.
+    scene.layout = snapshot_->layout.get();
+    scene.layout_version = (std::uint64_t(1) << 62) + snapshot_->version;
+  }
   // The parameterization belongs to the mesh the worker used; ignore stale snapshots.
   if (snapshot_ && snapshot_->mesh == doc_.mesh) {
     scene.corner_uv = &snapshot_->corner_uv;

@@ -55,6 +55,8 @@ class App {
   void frame();
   void render_scene(int fb_width, int fb_height);
   void poll_worker();
+  //! True when the latest job snapshot (not the editor's layout) should be drawn.
+  bool job_layout_shown() const;
   bool automation() const { return !options_.screenshot_path.empty() || options_.quit; }
 
   // Files (app.cpp).

@@ -260,6 +260,24 @@ EditResult LayoutEditor::toggle_node_pin(int id) {
   return {};
 }
 
+EditResult LayoutEditor::replace_layout(Layout layout, const std::string& label) {
+  if (auto r = check_mesh(); !r) return r;
+  for (auto& arc : layout.arcs) {
+    arc.polyline.clear();
+    arc.samples.clear();
+    arc.label.clear();
+  }
+  for (auto& node : layout.nodes) {
+    node.position.reset();
+    node.valence = -1;
+  }
+  layout.patches.clear();
+  Layout before = layout_;
+  layout_ = std::move(layout);
+  commit(label, std::move(before));
+  return {};
+}
+
 EditResult LayoutEditor::toggle_arc_pin(int id) {
   if (auto r = check_mesh(); !r) return r;
   const int index = layout_.arc_index(id);

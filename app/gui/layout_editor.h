@@ -51,6 +51,9 @@ class LayoutEditor {
   EditResult split_arc(int arc_id, int vertex);
   EditResult toggle_node_pin(int id);
   EditResult toggle_arc_pin(int id);
+  //! Replaces the whole layout (e.g. by the optimized one) as one undoable edit. Traced output
+  //! fields (polylines, samples, labels, patches) are dropped: they describe the old solve.
+  EditResult replace_layout(Layout layout, const std::string& label);
 
   //! Interactive drag: previews are applied to layout() without history entries; end_drag
   //! records a single undo step (or nothing if the node did not move).

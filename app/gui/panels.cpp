@@ -319,6 +319,14 @@ void App::draw_pipeline_section() {
     }
   }
   if (!s.message.empty()) ImGui::TextWrapped("%s", s.message.c_str());
+  if (job_layout_shown() && s.status != WorkerStatus::Running) {
+    if (ImGui::Button("Keep result")) {
+      const Layout result = *s.layout;
+      apply(doc_.editor.replace_layout(result, "keep optimized layout"), "Optimized layout kept");
+    }
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("Make the optimized layout the one you edit and save (undo with Ctrl+Z)");
+  }
   std::vector<float> energies;
   for (double e : s.energy_history)
     if (std::isfinite(e)) energies.push_back(float(e));

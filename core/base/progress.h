@@ -11,14 +11,14 @@ namespace qs {
 
 //! One iteration of an iterative optimization (interfaces.md report.json "steps").
 struct StepReport {
-  int step = 0;            //!< 1-based iteration number (0: the initial solve)
-  double E = 0;            //!< residual of energy (1) after the step (length² units)
-  bool accepted = false;   //!< false: E rose, the step was undone
-  double step_size = 0;    //!< damping factor α in force for this step (dimensionless)
-  int foldovers = 0;       //!< faces with signed parametric area ≤ 0 after the step
-  double time_s = 0;       //!< wall time of this step (seconds)
-  int moved_nodes = 0;     //!< nodes whose position changed in this step
-  std::string phase;       //!< "descent", "discrete", "stiffening", …
+  int step = 0;           //!< 1-based iteration number (0: the initial solve)
+  double E = 0;           //!< residual of energy (1) after the step (length² units)
+  bool accepted = false;  //!< false: E rose, the step was undone
+  double step_size = 0;   //!< damping factor α in force for this step (dimensionless)
+  int foldovers = 0;      //!< faces with signed parametric area ≤ 0 after the step
+  double time_s = 0;      //!< wall time of this step (seconds)
+  int moved_nodes = 0;    //!< nodes whose position changed in this step
+  std::string phase;      //!< "descent", "discrete", "stiffening", …
   //! Node positions (3D, mesh units) after the step, in layout node order.
   std::vector<std::array<double, 3>> node_positions;
 };

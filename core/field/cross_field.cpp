@@ -221,6 +221,11 @@ const CrossField& CrossFieldSolver::solve(const GeometryCache& g) {
   return field_;
 }
 
+void CrossFieldSolver::rotate(double phi) {
+  for (double& t : field_.theta) t += phi;
+  if (field_.gauge_face >= 0) gauge_angle_(0) += phi;
+}
+
 CrossField compute_cross_field(const TriMesh& mesh, const GeometryCache& geometry,
                                const Layout& layout, const LayoutTopology& topology,
                                const CrossFieldOptions& options) {

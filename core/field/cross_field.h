@@ -47,6 +47,9 @@ class CrossFieldSolver {
   //! Solves for θ with the current geometry (reuses the factorization).
   const CrossField& solve(const GeometryCache& geometry);
   const CrossField& field() const { return field_; }
+  //! Rotates the whole field by φ (radians) — meaningful only when it has no direction
+  //! constraints (its global rotation is then free); later re-solves keep the rotation.
+  void rotate(double phi);
 
  private:
   Eigen::VectorXd rhs(const GeometryCache& geometry, const std::vector<double>& c) const;

@@ -606,6 +606,8 @@ PlyHeader parse_ply_header(const std::string& path, const std::string& bytes) {
       ended = true;
     } else if (key == "format" && tokens.size() == 3 && !has_format) {
       has_format = true;
+      // OpenMesh's header parser also loops forever on any other version.
+      if (tokens[2] != "1.0") errors.add(lines, "unsupported PLY version " + quoted(tokens[2]));
       if (tokens[1] == "ascii") {
         header.format = PlyHeader::Format::kAscii;
       } else if (tokens[1] == "binary_little_endian") {

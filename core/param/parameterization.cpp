@@ -305,6 +305,54 @@ const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCa
   return result_;
 }
 
+double ParamSolver::optimal_field_rotation(const TriMesh& mesh, const GeometryCache& g,
+                                           const std::vector<double>& theta) {
+  const int n = system_.variables;
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(18 * g.n_faces);
+  Eigen::VectorXd rhs0 = Eigen::VectorXd::Zero(n), rhs1 = Eigen::VectorXd::Zero(n);
+  for (int f = 0; f < g.n_faces; ++f) {
+    Eigen::Matrix<double, 2, 3> G;
+    double area;
+    face_gradients(mesh, g, f, G, area);
+    if (!options_.face_weights.empty()) area *= options_.face_weights[f];
+    const Eigen::Vector2d u(std::cos(theta[f]), std::sin(theta[f])), v(-u.y(), u.x());
+    const Eigen::Matrix3d H = area * G.transpose() * G;
+    const Eigen::Vector3d gu = area * G.transpose() * u, gv = area * G.transpose() * v;
+    int w[3];
+    for (int k = 0; k < 3; ++k) w[k] = cut_.corner_wedge[3 * f + k];
+    for (int k = 0; k < 3; ++k) {
+      // φ = 0: targets (u, v); φ = 90°: targets (v, −u).
+      rhs0(2 * w[k]) += gu(k);
+      rhs0(2 * w[k] + 1) += gv(k);
+      rhs1(2 * w[k]) += gv(k);
+      rhs1(2 * w[k] + 1) -= gu(k);
+      for (int l = 0; l < 3; ++l) {
+        triplets.emplace_back(2 * w[k], 2 * w[l], H(k, l));
+        triplets.emplace_back(2 * w[k] + 1, 2 * w[l] + 1, H(k, l));
+      }
+    }
+  }
+  Eigen::SparseMatrix<double> H(n, n);
+  H.setFromTriplets(triplets.begin(), triplets.end());
+  const Eigen::SparseMatrix<double>& Z = reduction_.Z;
+  const Eigen::SparseMatrix<double> A = (Z.transpose() * H * Z).eval();
+  Eigen::MatrixXd B(Z.cols(), 2);
+  B.col(0) = Z.transpose() * (rhs0 - H * reduction_.z0);
+  B.col(1) = Z.transpose() * (rhs1 - H * reduction_.z0);
+  solver_.factorize(A);
+  const Eigen::MatrixXd Y = solver_.solve(B);
+  // E(φ) = const − [c s] M [c s]ᵀ with M = Bᵀ Y: maximize the quadratic form.
+  Eigen::Matrix2d M = B.transpose() * Y;
+  M = 0.5 * (M + M.transpose()).eval();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(M);
+  const Eigen::Vector2d best = eig.eigenvectors().col(1);
+  double phi = std::atan2(best(1), best(0));
+  if (phi > M_PI / 2) phi -= M_PI;
+  if (phi <= -M_PI / 2) phi += M_PI;
+  return phi;
+}
+
 std::vector<double> face_energies(const TriMesh& mesh, const GeometryCache& g,
                                   const std::vector<double>& theta,
                                   const std::vector<std::array<double, 2>>& uv,

@@ -59,6 +59,13 @@ class ParamSolver {
   const Parameterization& solve(const TriMesh& mesh, const GeometryCache& geometry,
                                 const std::vector<double>& theta);
 
+  //! For a field whose global rotation is free (no direction constraints): the rotation φ
+  //! (radians) to add to every θ_t that minimizes the isotropic energy (1) under this solver's
+  //! constraints. E(φ) is a quadratic form in (cos φ, sin φ) because the constraints are
+  //! homogeneous, so two extra back-substitutions give the exact optimum.
+  double optimal_field_rotation(const TriMesh& mesh, const GeometryCache& geometry,
+                                const std::vector<double>& theta);
+
   const Parameterization& result() const { return result_; }
   const Labeling& labeling() const { return labeling_; }
   const CutGraph& cut_graph() const { return cut_; }

@@ -52,9 +52,13 @@ const Parameterization& Pipeline::compute_parameterization() {
   if (!param_solver_) {
     param_solver_ = std::make_unique<ParamSolver>(mesh_, geometry_, layout_, topology_,
                                                   field.period_jump, field.theta, options_.param);
-    return param_solver_->result();
+    if (field.gauge_face < 0) return param_solver_->result();
+    // No direction constraints: the field's global rotation is free. Take the one that
+    // minimizes the energy, not an arbitrary anchor (that would depend on arc routing).
   }
-  return param_solver_->solve(mesh_, geometry_, field.theta);
+  if (field.gauge_face >= 0)
+    field_solver_->rotate(param_solver_->optimal_field_rotation(mesh_, geometry_, field.theta));
+  return param_solver_->solve(mesh_, geometry_, field_solver_->field().theta);
 }
 
 const Parameterization* Pipeline::parameterization() const {

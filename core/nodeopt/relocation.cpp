@@ -1,0 +1,192 @@
+#include "core/nodeopt/relocation.h"
+
+#include <algorithm>
+
+#include "core/layout/routing.h"
+#include "core/layout/validate.h"
+
+namespace qs {
+
+namespace {
+
+Vec3 face_cross(const TriMesh& mesh, OpenMesh::FaceHandle f, int moved, const Vec3& target,
+                int restored, const TriMesh& original) {
+  Vec3 p[3];
+  int k = 0;
+  for (auto vh : mesh.fv_range(f)) {
+    if (vh.idx() == moved)
+      p[k] = target;
+    else if (vh.idx() == restored)
+      p[k] = original.point(vh);
+    else
+      p[k] = mesh.point(vh);
+    ++k;
+  }
+  return (p[1] - p[0]) % (p[2] - p[0]);
+}
+
+bool ring_ok(const TriMesh& mesh, const TriMesh& original, int center, int restored, int moved,
+             const Vec3& target, const RelocationOptions& options) {
+  for (auto fh : mesh.vf_range(mesh.vertex_handle(center))) {
+    const Vec3 c = face_cross(mesh, fh, moved, target, restored, original);
+    const Vec3 c0 = face_cross(original, fh, -1, target, -1, original);
+    const double l = c.norm(), l0 = c0.norm();
+    if (l0 <= 0) continue;
+    if (l < options.min_area_ratio * l0) return false;
+    if ((c | c0) < options.min_normal_cos * l * l0) return false;
+  }
+  return true;
+}
+
+bool cyclic_equal(const std::vector<int>& a, const std::vector<int>& b) {
+  if (a.size() != b.size()) return false;
+  if (a.empty()) return true;
+  for (size_t s = 0; s < b.size(); ++s) {
+    if (b[s] != a[0]) continue;
+    bool same = true;
+    for (size_t k = 0; k < a.size() && same; ++k) same = a[k] == b[(s + k) % b.size()];
+    if (same) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+bool relocation_keeps_orientation(const TriMesh& mesh, const TriMesh& original, int restored,
+                                  int vertex, const Vec3& target,
+                                  const RelocationOptions& options) {
+  if (!ring_ok(mesh, original, vertex, restored, vertex, target, options)) return false;
+  if (restored >= 0 && restored != vertex &&
+      !ring_ok(mesh, original, restored, restored, vertex, target, options))
+    return false;
+  return true;
+}
+
+int choose_relocation_vertex(const TriMesh& mesh, const TriMesh& original,
+                             const SurfacePoint& target_point, const Vec3& target, int node_vertex,
+                             const std::vector<char>& forbidden, const RelocationOptions& options) {
+  std::vector<std::pair<double, int>> candidates;
+  for (auto vh : original.fv_range(original.face_handle(target_point.face))) {
+    const int v = vh.idx();
+    if (v != node_vertex && forbidden[v]) continue;
+    candidates.push_back({(original.point(vh) - target).sqrnorm(), v});
+  }
+  std::sort(candidates.begin(), candidates.end());
+  if (options.prefer_node_vertex) {
+    for (const auto& [dist, v] : candidates)
+      if (v == node_vertex && relocation_keeps_orientation(mesh, original, -1, v, target, options))
+        return v;
+  }
+  for (const auto& [dist, v] : candidates) {
+    const int restored = v == node_vertex ? -1 : node_vertex;
+    if (relocation_keeps_orientation(mesh, original, restored, v, target, options)) return v;
+  }
+  return -1;
+}
+
+std::vector<char> forbidden_relocation_vertices(const TriMesh& mesh, const Layout& layout,
+                                                int node_index) {
+  std::vector<char> out(mesh.n_vertices(), 0);
+  for (auto vh : mesh.vertices())
+    if (mesh.is_boundary(vh)) out[vh.idx()] = 1;
+  for (const auto& [a, b] : layout.feature_edges) {
+    if (a >= 0 && a < static_cast<int>(out.size())) out[a] = 1;
+    if (b >= 0 && b < static_cast<int>(out.size())) out[b] = 1;
+  }
+  const int id = layout.nodes[node_index].id;
+  for (const auto& arc : layout.arcs) {
+    if (arc.from == id || arc.to == id) continue;
+    for (int v : arc.path) out[v] = 1;
+  }
+  for (size_t n = 0; n < layout.nodes.size(); ++n)
+    if (static_cast<int>(n) != node_index) out[layout.nodes[n].vertex] = 1;
+  return out;
+}
+
+bool same_layout_structure(const LayoutTopology& a, const LayoutTopology& b) {
+  if (a.patches.size() != b.patches.size() || a.num_nodes != b.num_nodes) return false;
+  for (int n = 0; n < a.num_nodes; ++n)
+    if (!cyclic_equal(a.node_half_arcs[n], b.node_half_arcs[n])) return false;
+  return true;
+}
+
+bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, int new_vertex,
+                           const RelocationOptions& options) {
+  const int old_vertex = layout.nodes[node_index].vertex;
+  if (new_vertex == old_vertex) return true;
+  const LayoutTopology before = build_topology(mesh, layout);
+  const int id = layout.nodes[node_index].id;
+  // Incident arcs, in the node's cyclic order (a loop arc appears twice: skip those).
+  std::vector<int> incident;
+  for (int h : before.node_half_arcs[node_index]) {
+    const int a = LayoutTopology::arc_of(h);
+    if (std::find(incident.begin(), incident.end(), a) != incident.end()) return false;
+    incident.push_back(a);
+  }
+  for (int a : incident)
+    if (layout.arcs[a].pinned) return false;
+
+  for (int k = 2; k <= std::max(2, options.max_splice_edges); ++k) {
+    Layout trial = layout;
+    trial.nodes[node_index].vertex = new_vertex;
+    // Oriented paths (from the moving node) and the kept tails.
+    std::vector<std::vector<int>> tails(incident.size());
+    for (size_t i = 0; i < incident.size(); ++i) {
+      LayoutArc& arc = trial.arcs[incident[i]];
+      std::vector<int> path = arc.path;
+      if (arc.from != id) std::reverse(path.begin(), path.end());
+      // If the new vertex lies on this arc, keep everything after it.
+      const auto on = std::find(path.begin(), path.end(), new_vertex);
+      size_t cut = std::min<size_t>(k, path.size() - 1);
+      if (on != path.end()) cut = std::max<size_t>(cut, on - path.begin());
+      // Never cut at the far end of a non-dangling arc beyond its last vertex.
+      tails[i].assign(path.begin() + cut, path.end());
+      arc.path.clear();
+    }
+    RoutingObstacles obstacles = obstacles_of_layout(mesh, trial);
+    for (const auto& tail : tails) {
+      for (size_t j = 0; j < tail.size(); ++j) {
+        obstacles.vertex_blocked[tail[j]] = 1;
+        if (j > 0) {
+          const auto h =
+              mesh.find_halfedge(mesh.vertex_handle(tail[j - 1]), mesh.vertex_handle(tail[j]));
+          obstacles.edge_blocked[mesh.edge_handle(h).idx()] = 1;
+        }
+      }
+    }
+    bool ok = true;
+    for (size_t i = 0; i < incident.size() && ok; ++i) {
+      LayoutArc& arc = trial.arcs[incident[i]];
+      std::vector<int> head;
+      if (tails[i].front() == new_vertex) {
+        head = {new_vertex};
+      } else {
+        head = shortest_path(mesh, new_vertex, tails[i].front(), obstacles);
+        if (head.empty()) {
+          ok = false;
+          break;
+        }
+      }
+      for (size_t j = 0; j < head.size(); ++j) {
+        obstacles.vertex_blocked[head[j]] = 1;
+        if (j > 0) {
+          const auto h =
+              mesh.find_halfedge(mesh.vertex_handle(head[j - 1]), mesh.vertex_handle(head[j]));
+          obstacles.edge_blocked[mesh.edge_handle(h).idx()] = 1;
+        }
+      }
+      std::vector<int> path = head;
+      path.insert(path.end(), tails[i].begin() + 1, tails[i].end());
+      if (arc.from != id) std::reverse(path.begin(), path.end());
+      arc.path = std::move(path);
+    }
+    if (!ok) continue;
+    if (!validate_layout(mesh, trial).valid()) continue;
+    if (!same_layout_structure(before, build_topology(mesh, trial))) continue;
+    layout = std::move(trial);
+    return true;
+  }
+  return false;
+}
+
+}  // namespace qs

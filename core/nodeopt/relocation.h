@@ -1,0 +1,65 @@
+// Continuous node positioning by vertex relocation and re-routing of a moved node's arcs
+// (paper §6.1.1, algorithm.md §6.4).
+#pragma once
+
+#include <vector>
+
+#include "core/layout/layout.h"
+#include "core/mesh/mesh.h"
+
+namespace qs {
+
+struct RelocationOptions {
+  //! A relocation is allowed only if every face normal of the moved (and restored) vertices'
+  //! 1-rings keeps a cosine of at least this with its normal on the original mesh.
+  double min_normal_cos = 0.2;
+  //! Faces of those 1-rings must keep at least this fraction of their original area.
+  double min_area_ratio = 0.05;
+  //! Arc re-routing splices the new first part into the old path this many edges (2..max)
+  //! down from the old node vertex; the attempts go from 2 upwards until one validates.
+  int max_splice_edges = 5;
+  //! Hysteresis: keep the node on its current vertex whenever that vertex is a corner of the
+  //! target face and may be relocated there (the paper's rule, false, always takes the nearest).
+  bool prefer_node_vertex = false;
+};
+
+//! True when moving \p vertex of \p mesh to \p target (after first restoring \p restored to
+//! its position in \p original, when restored ≥ 0) keeps every incident face normal within
+//! RelocationOptions::min_normal_cos of its normal in \p original and every such face's area
+//! above min_area_ratio of the original area.
+//! \pre mesh and original have the same connectivity.
+bool relocation_keeps_orientation(const TriMesh& mesh, const TriMesh& original, int restored,
+                                  int vertex, const Vec3& target,
+                                  const RelocationOptions& options = {});
+
+//! Chooses the vertex of face \p target_point.face (a face of \p original) to carry a node
+//! moved to \p target (3D): among its corners that are \p node_vertex or not \p forbidden, the
+//! one nearest to \p target (original positions) whose relocation keeps the orientation (the
+//! node's old vertex \p node_vertex restored first when a different vertex is chosen).
+//! Returns -1 when no corner qualifies.
+//! \pre forbidden has size #V.
+int choose_relocation_vertex(const TriMesh& mesh, const TriMesh& original,
+                             const SurfacePoint& target_point, const Vec3& target, int node_vertex,
+                             const std::vector<char>& forbidden,
+                             const RelocationOptions& options = {});
+
+//! Vertices a moving node may not be relocated onto (size #V): other nodes' vertices, boundary
+//! vertices, vertices of feature edges, and vertices of arcs not incident to node \p node_index
+//! (an index into layout.nodes).
+std::vector<char> forbidden_relocation_vertices(const TriMesh& mesh, const Layout& layout,
+                                                int node_index);
+
+//! Moves node \p node_index of \p layout to \p new_vertex and re-routes its incident arcs: each
+//! arc keeps its old path from k edges after the node on (k = 2, 3, … max_splice_edges; the
+//! whole arc when it is shorter) and gets a new shortest first part from the new vertex that
+//! avoids every other arc and node. The move is kept only if the layout validates and has the
+//! same structure (same patch count, same cyclic order of half-arcs around every node) as
+//! before; otherwise \p layout is left unchanged and false is returned.
+//! \pre layout is valid on \p mesh (connectivity only; positions give the routing metric).
+bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, int new_vertex,
+                           const RelocationOptions& options = {});
+
+//! Same patch count and the same cyclic order of half-arcs around every node.
+bool same_layout_structure(const LayoutTopology& a, const LayoutTopology& b);
+
+}  // namespace qs
