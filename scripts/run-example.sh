@@ -12,5 +12,5 @@ fi
 out=out/example
 mkdir -p "$out"
 echo "run-example: no display; running the headless pipeline on $mesh"
-build/app/quadsketch-cli validate --mesh "$mesh" --layout "$layout" --out "$out"
-echo "run-example: results written to $out/"
+build/app/quadsketch-cli optimize --mesh "$mesh" --layout "$layout" --out "$out"
+echo "run-example: results written to $out/ (report.json, param.obj, field.txt, layout.json)"

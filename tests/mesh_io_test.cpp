@@ -8,7 +8,9 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -329,9 +331,16 @@ TEST(Degenerate, ThresholdSeparatesSliversFromZeroArea) {
   build_tri_mesh(soup, report, {});
   EXPECT_TRUE(report.degenerate_faces.empty());
   soup.faces.push_back({0, 4, 1});  // on the x axis: zero area
+  // Corners rounded onto a skew line: the computed area is rounding noise, not exactly 0.
+  const Vec3 a(0.1, 0.7, 0.3);
+  const Vec3 d(0.3, -0.2, 0.9);
+  soup.points.push_back(a);
+  soup.points.push_back(a + 0.37 * d);
+  soup.points.push_back(a + d);
+  soup.faces.push_back({5, 6, 7});
   MeshReport report2;
   build_tri_mesh(soup, report2, {});
-  EXPECT_EQ(report2.degenerate_faces, (std::vector<int>{2}));
+  EXPECT_EQ(report2.degenerate_faces, (std::vector<int>{2, 3}));
 }
 
 TEST(Report, ListsAtMostTenIdsAndKeepsReportWhenThrowing) {
@@ -515,6 +524,36 @@ TEST(OpenMeshFormats, PlyFaceWithMissingVertexIsReportedNotDuplicated) {
   EXPECT_EQ(report.bad_index_faces, (std::vector<int>{1}));
   EXPECT_NE(message.find("1 face refers to missing vertices (file face 1)"), std::string::npos)
       << message;
+}
+
+TEST(OpenMeshFormats, HostileCountsAreRefusedBeforeOpenMeshSeesThem) {
+  // OpenMesh's readers trust these counts and would loop for minutes (or forever).
+  TempDir dir;
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uint int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n";
+  const std::string huge_list = dir.write("huge_list.ply", header + "4000000000 0 1 2\n");
+  EXPECT_NE(error_of([&] { load_mesh(huge_list); }).find("the file ends in face 0 of 1"),
+            std::string::npos);
+  const std::string version = dir.write("version.ply", "ply\nformat ascii 2.0\nend_header\n");
+  EXPECT_NE(error_of([&] { load_mesh(version); }).find(":2: unsupported PLY version '2.0'"),
+            std::string::npos);
+
+  std::string off = "OFF BINARY\n";
+  const auto put = [&](std::uint32_t v) {
+    for (int k = 0; k < 4; ++k) off += static_cast<char>((v >> (8 * k)) & 0xff);
+  };
+  put(3), put(1), put(0);
+  for (float c : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) {
+    std::uint32_t bits = 0;
+    std::memcpy(&bits, &c, 4);
+    put(bits);
+  }
+  put(0xfffffff0u), put(0), put(1), put(2);
+  const std::string huge_face = dir.write("huge_face.off", off);
+  EXPECT_NE(error_of([&] { load_mesh(huge_face); }).find("binary OFF data ends in face 0 of 1"),
+            std::string::npos);
 }
 
 // ---------------------------------------------------------------------------------------------

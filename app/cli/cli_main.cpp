@@ -43,9 +43,9 @@ int main(int argc, char** argv) {
   cmd_opt->add_option("--steps", opt.steps, "Maximum number of node optimization steps")
       ->capture_default_str();
   cmd_opt->add_flag("--no-node-opt", opt.no_node_opt, "Only field and parameterization");
-  auto* quad_size_opt = cmd_opt->add_option(
-      "--quad-size", opt.quad_size,
-      "Write quads.obj, patches.json, layout_curves.obj with this quad size");
+  auto* quad_size_opt =
+      cmd_opt->add_option("--quad-size", opt.quad_size,
+                          "Write quads.obj, patches.json, layout_curves.obj with this quad size");
   cmd_opt
       ->add_option("--quad-count", opt.quad_count,
                    "Like --quad-size, choosing the size for about N quads")

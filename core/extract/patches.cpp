@@ -102,7 +102,8 @@ PatchChart build_patch_chart(const TriMesh& mesh, const GeometryCache& g, const 
   }
   for (int d : P.darts)
     if (!ex.arcs[d >> 1].ok)
-      return fail("arc " + std::to_string(layout.arcs[d >> 1].id) + " of its border failed to trace");
+      return fail("arc " + std::to_string(layout.arcs[d >> 1].id) +
+                  " of its border failed to trace");
   const auto len = [&](int k) { return ex.arcs[P.darts[k] >> 1].param_length; };
   chart.w = 0.5 * (len(0) + len(2));
   chart.h = 0.5 * (len(1) + len(3));

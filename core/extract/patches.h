@@ -39,11 +39,11 @@ struct PatchChartOptions {
 //! surface is oriented).
 class PatchChart {
  public:
-  int patch = -1;             //!< patch index in LayoutTopology::patches
-  bool ok = false;            //!< the chart was built and its corners check out
-  std::string failure;        //!< why not, when !ok
-  double w = 0, h = 0;        //!< rectangle size, parameter units
-  double corner_error = 0;    //!< max distance of a corner node from its rectangle corner
+  int patch = -1;           //!< patch index in LayoutTopology::patches
+  bool ok = false;          //!< the chart was built and its corners check out
+  std::string failure;      //!< why not, when !ok
+  double w = 0, h = 0;      //!< rectangle size, parameter units
+  double corner_error = 0;  //!< max distance of a corner node from its rectangle corner
   std::vector<PatchChartTriangle> triangles;
 
   //! Locates patch coordinates \p st on the surface. Returns false when no placed triangle

@@ -208,17 +208,16 @@ QuadMesh build_quad_mesh(const TriMesh& mesh, const GeometryCache& g, const Layo
     };
     if (!usable[p]) {
       if (!is_quad_patch(P))
-        skip(P.trimmed ? "trimmed patch (bare mesh boundary on its border)"
-                       : "not a 4-sided disk patch (" + std::to_string(P.darts.size()) +
-                             " arc sides)");
+        skip(P.trimmed
+                 ? "trimmed patch (bare mesh boundary on its border)"
+                 : "not a 4-sided disk patch (" + std::to_string(P.darts.size()) + " arc sides)");
       else
         skip("an arc of its border failed to trace");
       continue;
     }
     for (int k = 0; k < 4; ++k) qp.nodes[k] = P.corners[k], qp.darts[k] = P.darts[k];
-    const PatchChart chart =
-        build_patch_chart(mesh, g, layout, topo, ex, period_jump, uv, static_cast<int>(p),
-                          opt.chart);
+    const PatchChart chart = build_patch_chart(mesh, g, layout, topo, ex, period_jump, uv,
+                                               static_cast<int>(p), opt.chart);
     if (!chart.ok) {
       skip("chart: " + chart.failure);
       continue;

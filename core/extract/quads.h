@@ -28,13 +28,13 @@ struct QuadMeshOptions {
 
 //! One gridded patch.
 struct QuadPatch {
-  int patch = -1;                   //!< index in LayoutTopology::patches (= output patch id)
-  bool ok = false;                  //!< gridded; false: skipped (see failure)
-  std::string failure;              //!< why it was skipped
-  std::array<int, 4> nodes{};       //!< corner node indices (LayoutTopology::Patch::corners)
-  std::array<int, 4> darts{};       //!< border half-arcs; side k is arc darts[k] >> 1
-  std::array<double, 2> size{};     //!< (w, h), parameter units
-  std::array<int, 2> grid{};        //!< (m, n): quads along sides 0/2 and 1/3
+  int patch = -1;                     //!< index in LayoutTopology::patches (= output patch id)
+  bool ok = false;                    //!< gridded; false: skipped (see failure)
+  std::string failure;                //!< why it was skipped
+  std::array<int, 4> nodes{};         //!< corner node indices (LayoutTopology::Patch::corners)
+  std::array<int, 4> darts{};         //!< border half-arcs; side k is arc darts[k] >> 1
+  std::array<double, 2> size{};       //!< (w, h), parameter units
+  std::array<int, 2> grid{};          //!< (m, n): quads along sides 0/2 and 1/3
   int first_quad = 0, num_quads = 0;  //!< range in QuadMesh::quads
   //! Grid vertex (i, j), 0 ≤ i ≤ m, 0 ≤ j ≤ n, at grid_vertices[j·(m+1) + i]: index into
   //! QuadMesh::vertices. (0,0) is corner 0, (m,0) corner 1, (m,n) corner 2, (0,n) corner 3.
@@ -55,8 +55,8 @@ struct QuadMesh {
   //! Per arc: its shared vertices (from node to to node, arc_segments + 1 of them; empty when
   //! arc_segments is 0). Indices into `vertices`.
   std::vector<std::vector<int>> arc_vertices;
-  std::vector<int> node_vertex;        //!< per node: index into `vertices`, or -1
-  std::vector<std::string> warnings;   //!< skipped patches, poor point location, ...
+  std::vector<int> node_vertex;       //!< per node: index into `vertices`, or -1
+  std::vector<std::string> warnings;  //!< skipped patches, poor point location, ...
   int gridded_patches() const;
 };
 

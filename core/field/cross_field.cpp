@@ -97,6 +97,7 @@ CrossFieldSolver::CrossFieldSolver(const TriMesh& mesh, const GeometryCache& g,
   }
   field_.clusters = static_cast<int>(cluster_size.size());
   cluster_offset_.assign(field_.clusters, 0);
+  cluster_active_.assign(field_.clusters, 1);
 
   // Matrix: dual-graph Laplacian + λ on constrained faces (+ a gauge face if unconstrained).
   std::vector<Eigen::Triplet<double>> triplets;
@@ -155,8 +156,60 @@ CrossFieldSolver::CrossFieldSolver(const TriMesh& mesh, const GeometryCache& g,
     round_clusters(g, c, theta0);
   }
   solver_.factorize(L);
-  field_.timings.factorize_s = seconds_since(t0);
   solve(g);
+  // Drop constraint clusters that contradict the layout's topology, then re-solve.
+  for (int pass = 0; pass < options.max_conflict_passes && nc > 0; ++pass) {
+    const std::vector<int> matching = principal_matching(g, field_.theta);
+    std::vector<int> dist(nf, -1);
+    std::deque<int> queue;
+    for (int e = 0; e < g.n_edges; ++e) {
+      if (!interior(g, e) || matching[e] == field_.period_jump[e]) continue;
+      for (int f : {g.edge_face_i[e], g.edge_face_j[e]})
+        if (dist[f] < 0) dist[f] = 0, queue.push_back(f);
+    }
+    if (queue.empty()) break;
+    std::vector<int> drop;
+    while (!queue.empty()) {
+      const int f = queue.front();
+      queue.pop_front();
+      const int k = constraint_at[f];
+      if (k >= 0 && cluster_active_[cluster_of_[k]] &&
+          std::find(drop.begin(), drop.end(), cluster_of_[k]) == drop.end())
+        drop.push_back(cluster_of_[k]);
+      if (dist[f] >= options.conflict_rings) continue;
+      for (auto h : mesh.fh_range(mesh.face_handle(f))) {
+        const auto opp = mesh.opposite_halfedge_handle(h);
+        if (mesh.is_boundary(opp)) continue;
+        const int f2 = mesh.face_handle(opp).idx();
+        if (dist[f2] < 0) dist[f2] = dist[f] + 1, queue.push_back(f2);
+      }
+    }
+    if (drop.empty()) break;
+    for (int cl : drop) {
+      cluster_active_[cl] = 0;
+      ++field_.dropped_clusters;
+    }
+    for (int k = 0; k < nc; ++k) {
+      if (cluster_active_[cluster_of_[k]] ||
+          std::find(drop.begin(), drop.end(), cluster_of_[k]) == drop.end())
+        continue;
+      L.coeffRef(field_.constraints.face[k], field_.constraints.face[k]) -= lambda;
+      ++field_.dropped_constraints;
+    }
+    if (std::find(cluster_active_.begin(), cluster_active_.end(), 1) == cluster_active_.end() &&
+        field_.gauge_face < 0) {
+      // Nothing left to fix the global rotation on a closed surface: pin one face (it is
+      // re-chosen to minimize the energy by the parameterization stage).
+      field_.gauge_face = field_.constraints.face[0];
+      gauge_angle_.resize(1);
+      gauge_angle_(0) = field_.theta[field_.gauge_face];
+      L.coeffRef(field_.gauge_face, field_.gauge_face) += lambda;
+    }
+    solver_.factorize(L);
+    solve(g);
+  }
+  field_.active_constraints = nc - field_.dropped_constraints;
+  field_.timings.factorize_s = seconds_since(t0);
 }
 
 CrossFieldSolver::~CrossFieldSolver() = default;
@@ -171,6 +224,7 @@ Eigen::VectorXd CrossFieldSolver::rhs(const GeometryCache& g, const std::vector<
   }
   const double lambda = options_.constraint_weight;
   for (size_t k = 0; k < c.size(); ++k) {
+    if (!cluster_active_[cluster_of_[k]]) continue;
     const int q = relative_q_[k] + cluster_offset_[cluster_of_[k]];
     b(field_.constraints.face[k]) += lambda * (c[k] + kQuarter * q);
   }

@@ -17,6 +17,12 @@ struct CrossFieldOptions {
   double constraint_weight = 100.0;  //!< λ, the paper's penalty factor
   ConstraintOptions constraints;
   int max_rounding_passes = 5;  //!< re-rounding of cluster rotations after each solve
+  //! Constraint clusters that contradict the layout's topology (the solved field then jumps by
+  //! more than 45° across some edge, i.e. its principal matching differs from the prescribed
+  //! period jumps) are dropped: the nearest clusters within `conflict_rings` face rings of each
+  //! such edge, for at most `max_conflict_passes` re-solves.
+  int max_conflict_passes = 6;
+  int conflict_rings = 6;
 };
 
 struct CrossFieldTimings {
@@ -30,6 +36,9 @@ struct CrossField {
   std::vector<int> constraint_q;  //!< per constraint: integer quarter-turn offset
   int clusters = 0;               //!< constraint clusters (each with one free rotation)
   int gauge_face = -1;            //!< face pinned when there are no constraints
+  int dropped_clusters = 0;       //!< clusters dropped because they contradict the topology
+  int dropped_constraints = 0;    //!< constrained faces in those clusters
+  int active_constraints = 0;     //!< constrained faces still in force
   PeriodJumpReport topology;
   CrossFieldTimings timings;
 };
@@ -61,6 +70,7 @@ class CrossFieldSolver {
   std::vector<int> cluster_of_;       //!< per constraint
   std::vector<int> relative_q_;       //!< per constraint, within its cluster
   std::vector<int> cluster_offset_;   //!< per cluster
+  std::vector<char> cluster_active_;  //!< per cluster: 0 once dropped as contradictory
   std::vector<Vec3> constraint_dir_;  //!< original 3D directions
   Eigen::VectorXd gauge_angle_;
   SpdSolver solver_{"cross field"};

@@ -58,7 +58,8 @@ struct ConstraintOptions {
   CurvatureOptions curvature_options;
 };
 
-//! Collects constraints: faces with a boundary edge follow it, faces with a sharp/feature edge
+//! Collects constraints: faces with a boundary edge that an arc runs along follow it (other
+//! boundary edges are left free: trimmed patches), faces with a sharp/feature edge
 //! follow that edge (boundary and feature constraints override curvature), reliable faces follow
 //! their principal directions.
 FieldConstraints collect_constraints(const TriMesh& mesh, const GeometryCache& geometry,

@@ -136,27 +136,23 @@ LayoutTopology build_topology(const TriMesh& mesh, const Layout& layout) {
   }
   topo.patches.assign(n_patches, {});
 
-  // Euler characteristic of each closed face set.
+  // Euler characteristic of each patch cut open along its border: every border vertex copy
+  // pairs with one border halfedge, so χ = F − E_inner + V_inner, where inner edges are
+  // non-wall edges and inner vertices touch no wall. This is right for slits too (an arc with
+  // the patch on both sides, e.g. a dangling arc into a hole).
   {
-    std::vector<int> vmark(mesh.n_vertices(), -1), emark(mesh.n_edges(), -1);
-    std::vector<std::vector<int>> faces_of(n_patches);
-    for (auto f : mesh.faces()) faces_of[topo.face_patch[f.idx()]].push_back(f.idx());
-    for (int pid = 0; pid < n_patches; ++pid) {
-      int nv = 0, ne = 0;
-      for (int fi : faces_of[pid]) {
-        for (auto h : mesh.fh_range(mesh.face_handle(fi))) {
-          const int vi = mesh.to_vertex_handle(h).idx();
-          const int ei = mesh.edge_handle(h).idx();
-          if (vmark[vi] != pid) vmark[vi] = pid, ++nv;
-          if (emark[ei] != pid) emark[ei] = pid, ++ne;
-        }
-      }
-      const int nf = static_cast<int>(faces_of[pid].size());
-      topo.patches[pid].faces = nf;
-      topo.patches[pid].euler = nv - ne + nf;
+    for (auto f : mesh.faces()) ++topo.patches[topo.face_patch[f.idx()]].euler;
+    for (auto e : mesh.edges())
+      if (!is_wall(e))
+        --topo.patches[topo.face_patch[mesh.face_handle(mesh.halfedge_handle(e, 0)).idx()]].euler;
+    for (auto v : mesh.vertices()) {
+      bool inner = !mesh.is_boundary(v);
+      for (auto h : mesh.voh_range(v)) inner = inner && !is_wall(mesh.edge_handle(h));
+      if (inner)
+        ++topo.patches[topo.face_patch[mesh.face_handle(mesh.halfedge_handle(v)).idx()]].euler;
     }
+    for (auto f : mesh.faces()) ++topo.patches[topo.face_patch[f.idx()]].faces;
   }
-
   // Border cycles (patch on the left), corners and darts.
   std::vector<char> visited(mesh.n_halfedges(), 0);
   auto next_border = [&](HH h) {

@@ -92,7 +92,7 @@ struct LayoutTopology {
     std::vector<int> corners;  //!< node indices along the border (with multiplicity)
     bool trimmed = false;      //!< part of the border is mesh boundary not covered by arcs
     int faces = 0;             //!< number of mesh faces
-    int euler = 0;             //!< Euler characteristic of the closed face set (1 for a disk)
+    int euler = 0;             //!< Euler characteristic cut open along the border (1 for a disk)
     int border_cycles = 0;     //!< number of border cycles (1 for a disk)
   };
   std::vector<Patch> patches;

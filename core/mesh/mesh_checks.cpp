@@ -12,8 +12,9 @@ namespace qs {
 namespace {
 
 // A face is degenerate when area <= kZeroAreaFactor * (bounding box diagonal)^2. The factor
-// is far below any real sliver (block.off's worst triangles are ~1e-7 relative) and well
-// above the rounding noise of exactly collinear corners (~1e-16 relative).
+// is far below any real sliver (the smallest area / diagonal^2 among the shared meshes is
+// 7e-9 in bunny.off, 1e-7 in block.off) and above the rounding noise of exactly collinear
+// corners (up to ~1e-15 when the corners are rounded onto a line).
 constexpr double kZeroAreaFactor = 1e-14;
 
 bool is_finite(const Vec3& p) {

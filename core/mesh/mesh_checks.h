@@ -16,8 +16,9 @@ namespace qs {
 //! Checks, all from the soup or the built mesh, never silently repaired:
 //! - bad_index_faces: an index outside [0, #points).
 //! - degenerate_faces: a repeated vertex index (not added), or zero area, i.e.
-//!   area <= 1e-14 * (bounding-box diagonal of the finite points)^2 (still added). Slivers such
-//!   as block.off's (relative area ~1e-7) stay valid; collinear corners give ~1e-16 or 0.
+//!   area <= 1e-14 * (bounding-box diagonal of the finite points)^2 (still added). Real
+//!   slivers stay valid (smallest area / diagonal^2 among the shared meshes: bunny.off 7e-9,
+//!   block.off 1e-7); collinear corners give 0 or rounding noise up to ~1e-15.
 //! - nonfinite_vertices: NaN or infinite coordinates.
 //! - dropped_faces / drop_reasons: add_face refused the face (an edge that already has two
 //!   faces, an edge already used in the same direction, a complex vertex) or it repeats an
@@ -27,6 +28,7 @@ namespace qs {
 //!   vertex, seen by is_manifold()) or refused some; plus every vertex !is_manifold().
 //! - unreferenced_vertices: used by no soup face.
 //! Then count_topology() fills the counts.
+//! \pre \p report is default-constructed except for path (lists are appended to).
 TriMesh build_tri_mesh(const PolygonSoup& soup, MeshReport& report, const LoadMeshOptions& options);
 
 //! Same for a polygon mesh (faces are kept as they are).

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <mutex>
 #include <ostream>
 #include <string_view>
 #include <system_error>
@@ -210,6 +211,12 @@ PolygonSoup parse_obj(const std::string& path, std::string_view text) {
         errors.add(lines, "vertex has " + std::to_string(n) + " coordinates, expected 3");
       } else {
         parse_point(tokens, 1, p, errors, lines);
+        for (std::size_t k = 4; k <= n; ++k) {
+          double ignored = 0.0;
+          if (parse_double(tokens[k], ignored) != NumberStatus::kOk) {
+            errors.add(lines, "vertex value " + quoted(tokens[k]) + " is not a number");
+          }
+        }
       }
       // Kept even when broken, so that later relative indices still count correctly.
       soup.points.push_back(p);
@@ -290,6 +297,7 @@ PolygonSoup parse_off(const std::string& path, std::string_view text) {
   ParseErrors errors(path);
   std::vector<std::string_view> tokens;
   std::vector<std::string_view> continuation;
+  std::vector<std::string_view> values;  // indices (and colour) of one face
   LineReader lines(text);
   std::string_view line;
   const auto next_tokens = [&]() {
@@ -381,7 +389,7 @@ PolygonSoup parse_off(const std::string& path, std::string_view text) {
       continue;
     }
     const int face_line = lines.number();
-    std::vector<std::string_view> values(tokens.begin() + 1, tokens.end());
+    values.assign(tokens.begin() + 1, tokens.end());
     const long long listed = static_cast<long long>(values.size());
     if (listed < n) {
       // Some writers put one index per line (libigl's inspired_mesh quads). The face may go on
@@ -425,11 +433,14 @@ PolygonSoup parse_off(const std::string& path, std::string_view text) {
     bool ok = true;
     for (long long i = 0; i < n; ++i) {
       long long index = 0;
-      if (parse_integer(values[i], index) == NumberStatus::kNotANumber) {
-        errors.add(lines, "face vertex index " + quoted(values[i]) + " is not an integer");
-        ok = false;
-      } else {
+      const NumberStatus status = parse_integer(values[i], index);
+      if (status == NumberStatus::kOk) {
         face.push_back(clamp_index(index));
+      } else {
+        errors.add(lines, "face vertex index " + quoted(values[i]) +
+                              (status == NumberStatus::kNotANumber ? " is not an integer"
+                                                                   : " is out of range"));
+        ok = false;
       }
     }
     for (std::size_t i = static_cast<std::size_t>(n); i < values.size(); ++i) {
@@ -513,8 +524,9 @@ std::string uppercase(std::string s) {
   return s;
 }
 
-// Binary STL is recognized like OpenMesh does: the size matches 84 + 50 * #triangles.
-// Returns the number of triangles the file holds, for the skipped-face check.
+// Binary STL is recognized like OpenMesh does: the size matches 84 + 50 * #triangles. ASCII
+// STL is checked line by line. Returns the number of triangles the file holds, so that the
+// ones OpenMesh's reader skips can be counted.
 long long stl_triangle_count(const std::string& path, const std::string& bytes) {
   if (bytes.size() >= 84) {
     std::uint32_t n = 0;
@@ -528,17 +540,43 @@ long long stl_triangle_count(const std::string& path, const std::string& bytes) 
                             ": not an STL file (neither 'solid' ASCII nor a binary STL whose "
                             "size matches its triangle count)");
   }
-  // OpenMesh's ASCII reader starts a triangle at every line containing "outer" or "OUTER".
-  long long n = 0;
+  // OpenMesh's ASCII reader starts a triangle at every line containing "outer" or "OUTER" and
+  // takes the next three lines as its corners, whatever they hold (unparsable numbers keep the
+  // previous value). Check exactly that, so that a cut or garbled file is an error here.
+  ParseErrors errors(path);
+  std::vector<std::string_view> tokens;
+  long long facets = 0;
+  int corners_due = 0;
   LineReader lines(bytes);
   std::string_view line;
   while (lines.next(line)) {
-    if (line.find("outer") != std::string_view::npos ||
-        line.find("OUTER") != std::string_view::npos) {
-      ++n;
+    tokenize(line, tokens);
+    if (corners_due > 0) {
+      --corners_due;
+      if (tokens.size() != 4 || lowercase(std::string(tokens[0])) != "vertex") {
+        errors.add(lines, "expected 'vertex x y z' (three lines after each 'outer loop')");
+        continue;
+      }
+      for (int k = 1; k <= 3; ++k) {
+        double value = 0.0;
+        if (parse_double(tokens[k], value) != NumberStatus::kOk) {
+          errors.add(lines, "vertex coordinate " + quoted(tokens[k]) + " is not a number");
+        } else if (!std::isfinite(value)) {
+          errors.add(lines,
+                     "vertex coordinate " + quoted(tokens[k]) + " is non-finite (NaN or infinite)");
+        }
+      }
+    } else if (line.find("outer") != std::string_view::npos ||
+               line.find("OUTER") != std::string_view::npos) {
+      ++facets;
+      corners_due = 3;
     }
   }
-  return n;
+  if (corners_due > 0) {
+    errors.add(lines, "the file ends inside a facet (truncated?)");
+  }
+  errors.throw_if_any();
+  return facets;
 }
 
 // PLY scalar type: byte size (0 if unknown) and whether it is an integer type.
@@ -797,6 +835,10 @@ PolygonSoup read_with_openmesh(const std::string& path, const std::string& forma
   PolygonSoup soup;
   SoupImporter importer(scratch, soup);
   OpenMesh::IO::Options options;  // request nothing but positions and faces
+  // OpenMesh's readers are singletons with mutable state (options of the current file), so
+  // two threads must not read at the same time.
+  static std::mutex openmesh_readers;
+  const std::lock_guard<std::mutex> lock(openmesh_readers);
   if (!OpenMesh::IO::IOManager().read(path, importer, options)) {
     throw InvalidInputError(path + ": OpenMesh's " + uppercase(format) +
                             " reader could not read the file (malformed or unsupported " +

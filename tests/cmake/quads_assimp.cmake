@@ -10,9 +10,13 @@ if(NOT TARGET quadsketch-cli)
   return()
 endif()
 
+find_program(QS_SH sh)
+if(NOT QS_SH)
+  return()
+endif()
 set(QS_QUADS_ASSIMP_DIR ${CMAKE_CURRENT_BINARY_DIR}/quads_assimp)
 add_test(NAME quads_assimp_info
-  COMMAND sh -c [=[
+  COMMAND ${QS_SH} -c [=[
 set -u
 command -v assimp >/dev/null 2>&1 || { echo "assimp not on PATH: skipped"; exit 77; }
 rm -rf "$4" && mkdir -p "$4" || exit 1
