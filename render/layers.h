@@ -4,10 +4,13 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
+#include <utility>
 #include <vector>
 
 #include "core/layout/layout.h"
 #include "core/mesh/mesh.h"
+#include "core/pipeline/snapshot.h"
 #include "render/camera.h"
 
 namespace qs::render {
@@ -36,7 +39,17 @@ struct SceneData {
   int hovered_arc = -1;
   int arc_start_node = -1;
   std::vector<int> preview_path;
+  //! Optimistic pin state (node id, pinned) for pins sent to the worker but not yet applied.
+  std::vector<std::pair<int, bool>> pin_overrides;
   std::uint64_t interaction_version = 0;
+  //! Node positions per streamed step (null: no trajectories) and the step shown (index into
+  //! it, -1: none).
+  const std::vector<std::shared_ptr<const NodeFrame>>* node_history = nullptr;
+  int history_step = -1;
+  std::uint64_t history_version = 0;
+  //! Quad mesh overlay (null: none).
+  const QuadOverlay* quads = nullptr;
+  std::uint64_t quads_version = 0;
 };
 
 //! Per-frame drawing context.

@@ -6,8 +6,10 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <thread>
 
+#include "app/gui/history.h"
 #include "core/base/errors.h"
 
 namespace qs {
@@ -260,6 +262,144 @@ TEST(Worker, ShutsDownCleanlyDuringALongStep) {
     ASSERT_GT(entered.load(), 0);
   }  // ~Worker must return promptly
   EXPECT_LT(std::chrono::steady_clock::now() - start, 5s);
+}
+
+// A fake step that moves two nodes along x and reports metrics, like the editor's job.
+StepResult moving_nodes_step(WorkerState& state, const WorkerObserver&) {
+  StepResult r;
+  r.energy = 10.0 / (1 + state.iteration);
+  r.validate = false;
+  r.metrics.valid = true;
+  r.metrics.E = r.energy;
+  r.metrics.E_confor = 2.0 + state.iteration;
+  r.metrics.foldovers = state.iteration;
+  r.metrics.total_ms = 1.0;
+  auto frame = std::make_shared<NodeFrame>();
+  frame->ids = {7, 9};
+  frame->positions = {{float(state.iteration), 0, 0}, {float(state.iteration), 1, 0}};
+  r.nodes = frame;
+  if (state.iteration + 1 == state.options.max_steps) {
+    auto quads = std::make_shared<QuadOverlay>();
+    quads->vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    quads->quads = {{0, 1, 2, 3}};
+    r.quads = quads;
+  }
+  return r;
+}
+
+TEST(WorkerHistory, GrowsByOneNodeFramePerStepWithMetrics) {
+  Worker worker(moving_nodes_step);
+  WorkerOptions options;
+  options.max_steps = 5;
+  options.publish_interval_ms = 0;
+  worker.send(cmd::SetOptions{options});
+  worker.send(cmd::LoadMesh{tetrahedron(), Layout{}});
+  EXPECT_TRUE(worker.wait_for([](const Snapshot& x) { return x.mesh != nullptr; }, 5s)
+                  ->node_history.empty());
+  // Step by step: the history grows by exactly one frame per step.
+  for (int step = 1; step <= 3; ++step) {
+    worker.send(cmd::Step{});
+    const auto s = worker.wait_for([&](const Snapshot& x) { return x.iteration >= step; }, 5s);
+    ASSERT_EQ(s->iteration, step);
+    ASSERT_EQ(s->node_history.size(), std::size_t(step));
+    const NodeFrame& last = *s->node_history.back();
+    ASSERT_EQ(last.ids, (std::vector<int>{7, 9}));
+    EXPECT_FLOAT_EQ(last.positions[0][0], float(step - 1));
+    EXPECT_DOUBLE_EQ(s->energy_init, 10.0);
+    ASSERT_TRUE(s->metrics.valid);
+    EXPECT_DOUBLE_EQ(s->metrics.E_confor, 2.0 + (step - 1));
+    EXPECT_EQ(s->metrics.foldovers, step - 1);
+    EXPECT_FALSE(s->quads);  // built at the final step only
+  }
+  worker.send(cmd::Run{});
+  const auto s =
+      worker.wait_for([](const Snapshot& x) { return is(x, WorkerStatus::Finished); }, 5s);
+  ASSERT_EQ(s->status, WorkerStatus::Finished);
+  ASSERT_EQ(s->node_history.size(), 5u);
+  for (int k = 0; k < 5; ++k) EXPECT_FLOAT_EQ(s->node_history[k]->positions[1][0], float(k));
+  ASSERT_TRUE(s->quads);
+  EXPECT_EQ(s->quads->quads.size(), 1u);
+  EXPECT_DOUBLE_EQ(s->energy_init, 10.0);
+  EXPECT_DOUBLE_EQ(s->metrics.E, 2.0);
+
+  // A new job starts a fresh history.
+  worker.send(cmd::Stop{});
+  const auto stopped =
+      worker.wait_for([](const Snapshot& x) { return is(x, WorkerStatus::Cancelled); }, 5s);
+  EXPECT_TRUE(stopped->node_history.empty());
+  EXPECT_FALSE(stopped->quads);
+  EXPECT_FALSE(stopped->metrics.valid);
+  EXPECT_TRUE(std::isnan(stopped->energy_init));
+}
+
+TEST(WorkerHistory, StepResultWithoutFramesKeepsHistoryAndMetrics) {
+  std::atomic<int> calls{0};
+  Worker worker([&](WorkerState& state, const WorkerObserver& observer) {
+    StepResult r = moving_nodes_step(state, observer);
+    if (calls++ % 2 == 1) {  // every second step reports nothing new
+      r.nodes.reset();
+      r.metrics = StepMetrics{};
+    }
+    return r;
+  });
+  WorkerOptions options;
+  options.max_steps = 4;
+  options.publish_interval_ms = 0;
+  worker.send(cmd::SetOptions{options});
+  worker.send(cmd::LoadMesh{tetrahedron(), Layout{}});
+  worker.send(cmd::Run{});
+  const auto s =
+      worker.wait_for([](const Snapshot& x) { return is(x, WorkerStatus::Finished); }, 5s);
+  ASSERT_EQ(s->status, WorkerStatus::Finished);
+  EXPECT_EQ(s->node_history.size(), 2u);
+  ASSERT_TRUE(s->metrics.valid);
+  EXPECT_DOUBLE_EQ(s->metrics.E_confor, 2.0 + 2);  // from step 3, kept through step 4
+}
+
+TEST(WorkerHistory, ScrubIndexStaysInBounds) {
+  using app::scrub_index;
+  EXPECT_EQ(scrub_index(3, 0, false), -1);
+  EXPECT_EQ(scrub_index(-1, 0, true), -1);
+  EXPECT_EQ(scrub_index(-1, 5, true), 4);  // live: newest
+  EXPECT_EQ(scrub_index(2, 5, true), 4);
+  EXPECT_EQ(scrub_index(2, 5, false), 2);  // scrubbed: kept while steps stream in
+  EXPECT_EQ(scrub_index(2, 9, false), 2);
+  EXPECT_EQ(scrub_index(7, 5, false), 4);  // history shrank (new job): clamped
+  EXPECT_EQ(scrub_index(-3, 5, false), 0);
+}
+
+TEST(WorkerHistory, LivePinIsAppliedAtTheNextStep) {
+  std::atomic<bool> release{false};
+  Worker worker([&](WorkerState& state, const WorkerObserver& observer) {
+    while (!release) {
+      observer.check_cancel();
+      std::this_thread::sleep_for(1ms);
+    }
+    return moving_nodes_step(state, observer);
+  });
+  WorkerOptions options;
+  options.max_steps = 3;
+  options.publish_interval_ms = 0;
+  worker.send(cmd::SetOptions{options});
+  worker.send(cmd::LoadMesh{tetrahedron(), Layout{}});
+  worker.send(cmd::Run{});
+  std::this_thread::sleep_for(20ms);  // the first step is running
+  const auto pin_seq = worker.send(cmd::SetPin{7, 2});
+  // Not applied while the step that was running when it was sent is not done.
+  EXPECT_LT(worker.latest()->applied_seq, pin_seq);
+  release = true;
+  const auto s = worker.wait_for(
+      [&](const Snapshot& x) { return x.applied_seq >= pin_seq || is(x, WorkerStatus::Finished); },
+      5s);
+  ASSERT_GE(s->applied_seq, pin_seq);
+  ASSERT_EQ(s->pins.size(), 1u);
+  EXPECT_EQ(s->pins[0], (std::array<int, 2>{7, 2}));
+  const auto clear_seq = worker.send(cmd::ClearPin{7});
+  const auto f =
+      worker.wait_for([](const Snapshot& x) { return is(x, WorkerStatus::Finished); }, 5s);
+  if (f->applied_seq >= clear_seq) {
+    EXPECT_TRUE(f->pins.empty());
+  }
 }
 
 }  // namespace

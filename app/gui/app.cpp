@@ -16,6 +16,7 @@
 #include <iostream>
 #include <thread>
 
+#include "app/gui/history.h"
 #include "app/gui/pipeline_job.h"
 #include "app/gui/screenshot.h"
 
@@ -290,6 +291,10 @@ void App::poll_worker() {
                              snapshot_->iteration != latest->iteration;
   snapshot_ = std::move(latest);
   if (param_changed) ++param_version_;
+  // Pins the worker has now applied (or that a new job superseded) are no longer pending.
+  std::erase_if(pending_pins_,
+                [&](const PendingPin& p) { return p.seq <= snapshot_->applied_seq; });
+  history_step_ = scrub_index(history_step_, int(snapshot_->node_history.size()), history_live_);
 }
 
 int App::run() {
@@ -457,7 +462,15 @@ void App::render_scene(int fb_width, int fb_height) {
   scene.hovered_arc = hovered_arc_;
   scene.arc_start_node = arc_start_node_;
   scene.preview_path = preview_path_;
+  for (const auto& p : pending_pins_) scene.pin_overrides.emplace_back(p.node, p.pinned);
   scene.interaction_version = interaction_version_;
+  if (job_layout_shown()) {
+    scene.node_history = &snapshot_->node_history;
+    scene.history_step = history_step_;
+    scene.history_version = snapshot_->version;
+    scene.quads = snapshot_->quads.get();
+    scene.quads_version = snapshot_->version;
+  }
 
   render::FrameContext frame;
   frame.camera = &camera_;

@@ -84,6 +84,12 @@ class App {
   void redo();
   void delete_selection();
   void toggle_pin_selection();
+  //! True when pins go to the running/paused job (cmd::SetPin) instead of the editor.
+  bool live_pins() const;
+  //! Pinned state of \p node in the job as the user sees it (pending commands included).
+  bool job_node_pinned(int node) const;
+  //! Sends SetPin / ClearPin for \p node to the worker and remembers it until applied.
+  void toggle_live_pin(int node);
   void set_tool(Tool tool);
 
   // Panels (panels.cpp).
@@ -95,6 +101,9 @@ class App {
   void draw_layout_section();
   void draw_validation_section();
   void draw_pipeline_section();
+  void draw_history_controls();
+  void draw_quads_section();
+  void draw_metrics_panel();
   void draw_error_panel();
   void draw_autosave_prompt();
   void draw_status_bar();
@@ -147,6 +156,20 @@ class App {
   int highlighted_issue_ = -1;
   bool show_demo_ = false;
   std::string shader_log_;
+  WorkerOptions worker_options_;
+  //! Scrubbed step (index into Snapshot::node_history); follows the latest step when live.
+  int history_step_ = -1;
+  bool history_live_ = true;
+  //! Pins sent to the worker and not yet reflected in a snapshot (drawn optimistically).
+  struct PendingPin {
+    int node = -1;
+    bool pinned = false;
+    std::uint64_t seq = 0;
+  };
+  std::vector<PendingPin> pending_pins_;
+  std::string export_dir_;
+  std::string export_message_;
+  bool export_failed_ = false;
 
   // Automation and timing.
   int frame_count_ = 0;

@@ -207,7 +207,9 @@ void App::click(const glm::vec2& mouse) {
       if (arc == selected_arc_) selected_arc_ = -1;
       break;
     case Tool::Pin:
-      if (node >= 0)
+      if (node >= 0 && live_pins())
+        toggle_live_pin(node);
+      else if (node >= 0)
         apply(doc_.editor.toggle_node_pin(node), "Pin toggled on node " + std::to_string(node));
       else if (arc >= 0)
         apply(doc_.editor.toggle_arc_pin(arc), "Pin toggled on arc " + std::to_string(arc));
@@ -362,8 +364,40 @@ void App::delete_selection() {
   }
 }
 
+bool App::live_pins() const {
+  return job_layout_shown() &&
+         (snapshot_->status == WorkerStatus::Running || snapshot_->status == WorkerStatus::Paused);
+}
+
+bool App::job_node_pinned(int node) const {
+  for (auto it = pending_pins_.rbegin(); it != pending_pins_.rend(); ++it)
+    if (it->node == node) return it->pinned;
+  if (!snapshot_) return false;
+  for (const auto& pin : snapshot_->pins)
+    if (pin[0] == node) return true;
+  if (snapshot_->layout)
+    if (int k = snapshot_->layout->node_index(node); k >= 0)
+      return snapshot_->layout->nodes[k].pinned;
+  return false;
+}
+
+void App::toggle_live_pin(int node) {
+  const Layout& layout = *snapshot_->layout;
+  const int k = layout.node_index(node);
+  if (k < 0) return;
+  const bool pin = !job_node_pinned(node);
+  const std::uint64_t seq = pin ? worker_->send(cmd::SetPin{node, layout.nodes[k].vertex})
+                                : worker_->send(cmd::ClearPin{node});
+  pending_pins_.push_back({node, pin, seq});
+  ++interaction_version_;
+  status_ = std::string(pin ? "Pinning" : "Unpinning") + " node " + std::to_string(node) +
+            " in the running job (applies at the next step)";
+}
+
 void App::toggle_pin_selection() {
-  if (selected_node_ >= 0)
+  if (selected_node_ >= 0 && live_pins())
+    toggle_live_pin(selected_node_);
+  else if (selected_node_ >= 0)
     apply(doc_.editor.toggle_node_pin(selected_node_), "Pin toggled");
   else if (selected_arc_ >= 0)
     apply(doc_.editor.toggle_arc_pin(selected_arc_), "Pin toggled");

@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "app/gui/app.h"
+#include "app/gui/pipeline_job.h"
 #include "core/layout/layout_io.h"
 
 namespace qs::app {
@@ -82,10 +83,24 @@ const char* tool_hint(Tool tool) {
   return "";
 }
 
+// One "name  value" row of the metrics table; NaN shows as a dash.
+void metric_row(const char* name, double value, const char* format, const char* tip = nullptr) {
+  ImGui::TableNextRow();
+  ImGui::TableNextColumn();
+  ImGui::TextUnformatted(name);
+  if (tip && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", tip);
+  ImGui::TableNextColumn();
+  if (std::isfinite(value))
+    ImGui::Text(format, value);
+  else
+    ImGui::TextDisabled("-");
+}
+
 }  // namespace
 
 void App::draw_ui() {
   draw_main_panel();
+  draw_metrics_panel();
   draw_error_panel();
   draw_autosave_prompt();
   draw_status_bar();
@@ -107,6 +122,7 @@ void App::draw_main_panel() {
   draw_layout_section();
   draw_validation_section();
   draw_pipeline_section();
+  draw_quads_section();
   draw_view_section();
   ImGui::End();
 }
@@ -330,9 +346,167 @@ void App::draw_pipeline_section() {
   std::vector<float> energies;
   for (double e : s.energy_history)
     if (std::isfinite(e)) energies.push_back(float(e));
+  // imgui 1.86's PlotLines does not accept a negative width: pass the available width.
   if (energies.size() >= 2)
     ImGui::PlotLines("##energy", energies.data(), int(energies.size()), 0, "energy", FLT_MAX,
-                     FLT_MAX, ImVec2(-1, 3.0f * ImGui::GetFontSize()));
+                     FLT_MAX,
+                     ImVec2(ImGui::GetContentRegionAvail().x, 3.0f * ImGui::GetFontSize()));
+  draw_history_controls();
+}
+
+void App::draw_history_controls() {
+  if (!job_layout_shown()) return;
+  const Snapshot& s = *snapshot_;
+  const int steps = int(s.node_history.size());
+  if (steps == 0) return;
+  ImGui::PushID("history");
+  // Scrub through the streamed steps (1 = initial solve); "Live" follows the newest one.
+  int shown = std::clamp(history_step_, 0, steps - 1) + 1;
+  ImGui::SetNextItemWidth(-4.5f * ImGui::GetFontSize());
+  if (steps == 1) ImGui::BeginDisabled();
+  if (ImGui::SliderInt("##step", &shown, 1, std::max(1, steps), "step %d")) {
+    history_step_ = std::clamp(shown, 1, steps) - 1;
+    history_live_ = history_step_ == steps - 1;
+  }
+  if (steps == 1) ImGui::EndDisabled();
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip(
+        "Scrub through the streamed steps; node trajectories show where each "
+        "node moved, the chosen step's nodes are ringed in cyan.");
+  ImGui::SameLine();
+  if (ImGui::Checkbox("Live", &history_live_) && history_live_) history_step_ = steps - 1;
+  const int k = std::clamp(history_step_, 0, steps - 1);
+  if (k < int(s.energy_history.size()) && std::isfinite(s.energy_history[k]))
+    ImGui::TextColored(kDimColor, "step %d of %d: E = %.6g%s", k + 1, steps, s.energy_history[k],
+                       k == 0 ? " (initial solve)" : "");
+  ImGui::PopID();
+}
+
+void App::draw_quads_section() {
+  if (!ImGui::CollapsingHeader("Quad mesh & export", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  ImGui::PushID("quads");
+  // Quad size in surface units; 0 = automatic (about kDefaultQuadCount quads).
+  float diag = 1.0f;
+  if (doc_.mesh && doc_.mesh->n_vertices() > 0) {
+    glm::vec3 lo(1e30f), hi(-1e30f);
+    for (auto vh : doc_.mesh->vertices()) {
+      const auto& p = doc_.mesh->point(vh);
+      const glm::vec3 q{float(p[0]), float(p[1]), float(p[2])};
+      lo = glm::min(lo, q);
+      hi = glm::max(hi, q);
+    }
+    diag = std::max(glm::length(hi - lo), 1e-6f);
+  }
+  float quad_size = float(worker_options_.quad_size);
+  char format[64];
+  std::snprintf(format, sizeof(format), quad_size > 0.0f ? "q = %%.4g" : "auto (~%d quads)",
+                kDefaultQuadCount);
+  ImGui::SetNextItemWidth(-4.5f * ImGui::GetFontSize());
+  if (ImGui::SliderFloat("Quad size", &quad_size, 0.0f, 0.2f * diag, format))
+    worker_options_.quad_size = quad_size;
+  if (ImGui::IsItemDeactivatedAfterEdit()) worker_->send(cmd::SetOptions{worker_options_});
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip(
+        "Target quad edge length; the quad mesh is built on the worker at the "
+        "final step of a run (0: automatic). Ctrl+click to type a value.");
+  const Snapshot* s = job_layout_shown() ? snapshot_.get() : nullptr;
+  if (s && s->quads) {
+    const QuadOverlay& q = *s->quads;
+    ImGui::TextColored(kOkColor, "%zu quads, %zu vertices, q = %.4g", q.quads.size(),
+                       q.vertices.size(), q.quad_size);
+    ImGui::TextColored(q.gridded_patches < q.patches ? kWarningColor : kDimColor,
+                       "%d of %d patches gridded", q.gridded_patches, q.patches);
+    if (!q.warnings.empty() && ImGui::IsItemHovered()) {
+      ImGui::BeginTooltip();
+      for (const auto& w : q.warnings) ImGui::TextUnformatted(w.c_str());
+      ImGui::EndTooltip();
+    }
+  } else {
+    ImGui::TextDisabled("Run the pipeline to the end to build the quad mesh.");
+  }
+
+  const float button = 4.5f * ImGui::GetFontSize();
+  ImGui::SetNextItemWidth(-button);
+  ImGui::InputTextWithHint("##dir", "export folder", &export_dir_);
+  const bool can_export = s && s->exports;
+  if (!can_export) ImGui::BeginDisabled();
+  auto export_files = [&](const ExportSelection& what) {
+    try {
+      const auto written = write_job_exports(*s->exports, export_dir_, what);
+      std::string list;
+      for (const auto& f : written) list += (list.empty() ? "" : ", ") + f;
+      export_message_ = "Wrote " + list + " to " + export_dir_;
+      export_failed_ = false;
+      status_ = export_message_;
+    } catch (const std::exception& e) {
+      export_message_ = std::string("Export failed: ") + e.what();
+      export_failed_ = true;
+    }
+  };
+  ImGui::SameLine();
+  if (ImGui::Button("Export...", ImVec2(-1, 0))) export_files(ExportSelection{});
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("param.obj, layout.json, quads.obj, patches.json, layout_curves.obj");
+  if (ImGui::Button("param.obj")) export_files({true, false, false});
+  ImGui::SameLine();
+  if (ImGui::Button("layout.json")) export_files({false, true, false});
+  ImGui::SameLine();
+  const bool has_quads = can_export && s->exports->quads;
+  if (!has_quads && can_export) ImGui::BeginDisabled();
+  if (ImGui::Button("quads.obj...")) export_files({false, false, true});
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("quads.obj, patches.json, layout_curves.obj");
+  if (!has_quads && can_export) ImGui::EndDisabled();
+  if (!can_export) ImGui::EndDisabled();
+  if (!export_message_.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, export_failed_ ? kErrorColor : kDimColor);
+    ImGui::TextWrapped("%s", export_message_.c_str());
+    ImGui::PopStyleColor();
+  }
+  ImGui::PopID();
+}
+
+void App::draw_metrics_panel() {
+  if (!job_layout_shown()) return;
+  const Snapshot& s = *snapshot_;
+  const StepMetrics& m = s.metrics;
+  const ImGuiIO& io = ImGui::GetIO();
+  const float width = 15.0f * ImGui::GetFontSize();
+  ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - width - 10.0f, 10.0f), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(width, 0.0f), ImGuiCond_FirstUseEver);
+  ImGui::Begin("Metrics", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+  const ImGuiTableFlags flags = ImGuiTableFlags_SizingStretchProp | ImGuiTableFlags_RowBg;
+  if (ImGui::BeginTable("quality", 2, flags)) {
+    metric_row("E_init", s.energy_init, "%.6g", "Energy (1) after the initial solve");
+    metric_row("E", m.valid ? m.E : s.energy, "%.6g", "Energy (1) at the latest step");
+    if (std::isfinite(s.energy_init) && s.energy_init > 0.0 && std::isfinite(m.E))
+      metric_row("E / E_init", m.E / s.energy_init, "%.3f");
+    metric_row("E_confor", m.E_confor, "%.4f",
+               "Mean sigma1/sigma2 + sigma2/sigma1 (2 = conformal)");
+    metric_row("E\xc2\xb0", m.E_angle_deg, "%.2f\xc2\xb0",
+               "Deviation of the iso-lines from the principal directions, degrees in [0, 45]");
+    metric_row("E_planar", m.E_planar, "%.4g", "Conjugacy (dimensionless)");
+    ImGui::TableNextRow();
+    ImGui::TableNextColumn();
+    ImGui::TextUnformatted("fold-overs");
+    ImGui::TableNextColumn();
+    if (m.valid)
+      ImGui::TextColored(m.foldovers > 0 ? kErrorColor : kOkColor, "%d", m.foldovers);
+    else
+      ImGui::TextDisabled("-");
+    ImGui::EndTable();
+  }
+  ImGui::TextDisabled("Timings, step %d (ms)", s.iteration);
+  if (ImGui::BeginTable("timings", 2, flags)) {
+    metric_row("node opt.", m.nodeopt_ms, "%.1f");
+    metric_row("field", m.field_ms, "%.1f");
+    metric_row("param.", m.param_ms, "%.1f");
+    metric_row("extract", m.extract_ms, "%.1f");
+    metric_row("metrics", m.metrics_ms, "%.1f");
+    metric_row("quad mesh", m.quads_ms, "%.1f");
+    metric_row("total", m.total_ms, "%.1f");
+    ImGui::EndTable();
+  }
+  ImGui::End();
 }
 
 void App::draw_view_section() {

@@ -49,7 +49,9 @@ Reduction eliminate_constraints(const ConstraintSystem& sys, double tolerance) {
         continue;
       }
       const double a = std::abs(it->second);
-      if (a > best + 1e-12 || (std::abs(a - best) <= 1e-12 && it->first > pivot))
+      // Ties (all ±1 here) go to the lowest index: wedge values before the seam
+      // translations, which would otherwise chain the rows of one cut curve together.
+      if (a > best + 1e-12 || (std::abs(a - best) <= 1e-12 && (pivot < 0 || it->first < pivot)))
         best = a, pivot = it->first;
       ++it;
     }

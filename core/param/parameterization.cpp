@@ -148,18 +148,83 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
     add_row(x.u, 0.0, o);
     add_row(x.v, 0.0, o);
   }
-  // Seams: edge vectors agree up to the rotation across every cut edge.
-  for (int e = 0; e < g.n_edges; ++e) {
-    if (!cut_.cut[e]) continue;
-    const auto [a, b] = g.edge_vertices[e];
-    const int i = g.edge_face_i[e], j = g.edge_face_j[e];
-    const int r = step_rotation(p[e], a, b);
-    const Lin2 vi = sub(corner_expr(g, cut_, i, b), corner_expr(g, cut_, i, a));
-    const Lin2 vj = sub(corner_expr(g, cut_, j, b), corner_expr(g, cut_, j, a));
-    const Lin2 d = sub(vj, rotate(r, vi));
-    const int o = system_.add_origin("seam at edge " + edge_name(a, b));
-    add_row(d.u, 0.0, o);
-    add_row(d.v, 0.0, o);
+  // Seams: one translation t_c per cut curve (a maximal chain of cut edges through regular
+  // vertices of cut-valence 2). Across every cut edge, each endpoint w satisfies
+  // X_right(w) = R^r X_left(w) + t_c. Rows stay three terms long, so elimination does not chain
+  // along the curve (edge-vector rows would, filling the reduced matrix).
+  {
+    std::vector<int> cut_valence(g.n_vertices, 0);
+    for (int e = 0; e < g.n_edges; ++e)
+      if (cut_.cut[e]) ++cut_valence[g.edge_vertices[e][0]], ++cut_valence[g.edge_vertices[e][1]];
+    auto curve_node = [&](int v) {
+      return cut_valence[v] != 2 || singular[v] || g.vertex_on_boundary[v];
+    };
+    std::vector<char> done(g.n_edges, 0);
+    int curves = 0;
+    std::vector<std::vector<std::pair<OpenMesh::HalfedgeHandle, int>>>
+        curve_edges;  // (halfedge along, r)
+    for (int e0 = 0; e0 < g.n_edges; ++e0) {
+      if (!cut_.cut[e0] || done[e0]) continue;
+      // Walk backwards to the start of this curve (a curve node, or around a closed loop).
+      auto h = mesh.halfedge_handle(mesh.edge_handle(e0), 0);
+      const auto h_first = h;
+      for (int guard = 0; guard < g.n_edges; ++guard) {
+        const int v = mesh.from_vertex_handle(h).idx();
+        if (curve_node(v)) break;
+        OpenMesh::HalfedgeHandle prev;
+        for (auto o : mesh.vih_range(mesh.vertex_handle(v)))
+          if (cut_.cut[mesh.edge_handle(o).idx()] && mesh.edge_handle(o) != mesh.edge_handle(h))
+            prev = o;
+        if (!prev.is_valid() || prev == h_first) break;
+        h = prev;
+        if (h == h_first) break;
+      }
+      // Walk forwards, splitting where the rotation changes.
+      std::vector<std::pair<OpenMesh::HalfedgeHandle, int>> edges;
+      int r_curve = -1;
+      for (int guard = 0; guard < g.n_edges; ++guard) {
+        const int e = mesh.edge_handle(h).idx();
+        if (done[e]) break;
+        const int w = mesh.from_vertex_handle(h).idx(), z = mesh.to_vertex_handle(h).idx();
+        const int r = step_rotation(p[e], w, z);
+        if (r_curve >= 0 && r != r_curve) {
+          curve_edges.push_back(std::move(edges));
+          edges.clear();
+        }
+        r_curve = r;
+        done[e] = 1;
+        edges.push_back({h, r});
+        if (curve_node(z)) break;
+        OpenMesh::HalfedgeHandle next;
+        for (auto o : mesh.voh_range(mesh.vertex_handle(z)))
+          if (cut_.cut[mesh.edge_handle(o).idx()] && mesh.edge_handle(o) != mesh.edge_handle(h))
+            next = o;
+        if (!next.is_valid()) break;
+        h = next;
+      }
+      if (!edges.empty()) curve_edges.push_back(std::move(edges));
+    }
+    curves = static_cast<int>(curve_edges.size());
+    const int t0_index = system_.variables;
+    system_.variables += 2 * curves;
+    for (int c = 0; c < curves; ++c) {
+      const int tu = t0_index + 2 * c, tv = tu + 1;
+      for (const auto& [h, r] : curve_edges[c]) {
+        const int left = mesh.face_handle(h).idx();
+        const int right = mesh.face_handle(mesh.opposite_halfedge_handle(h)).idx();
+        const int a = mesh.from_vertex_handle(h).idx(), b = mesh.to_vertex_handle(h).idx();
+        const int o =
+            system_.add_origin("seam at edge " + edge_name(std::min(a, b), std::max(a, b)));
+        for (int w : {a, b}) {
+          Lin2 d = sub(corner_expr(g, cut_, right, w), rotate(r, corner_expr(g, cut_, left, w)));
+          d.u.push_back({tu, -1.0});
+          d.v.push_back({tv, -1.0});
+          add_row(d.u, 0.0, o);
+          add_row(d.v, 0.0, o);
+        }
+      }
+    }
+    result_.cut_curves = curves;
   }
   // Arcs: node connection (3); along boundary and pinned arcs every path vertex is on the
   // iso-line.

@@ -40,7 +40,7 @@ struct Parameterization {
                       //!< ParamOptions::face_weights when they are set
   int foldovers = 0;  //!< faces with signed parametric area ≤ 0
   // Diagnostics.
-  int wedges = 0, cut_edges = 0, constraint_rows = 0, eliminated = 0, redundant = 0, unknowns = 0;
+  int wedges = 0, cut_edges = 0, cut_curves = 0, constraint_rows = 0, eliminated = 0, redundant = 0, unknowns = 0;
   ParamTimings timings;
 };
 

@@ -21,6 +21,45 @@ enum class WorkerStatus { Idle, Running, Paused, Finished, Failed, Cancelled };
 //! Human-readable name ("idle", "running", ...).
 const char* to_string(WorkerStatus status);
 
+//! Quality metrics and stage timings of one step (computed on the worker). NaN: not measured.
+struct StepMetrics {
+  static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  bool valid = false;  //!< false: no metrics for this step (keep the previous ones)
+  double E = kNaN;     //!< energy (1) residual
+  double E_confor = kNaN;
+  double E_angle_deg = kNaN;  //!< E°
+  double E_planar = kNaN;
+  int foldovers = 0;
+  // Wall-clock milliseconds per stage of the step.
+  double nodeopt_ms = kNaN;  //!< node-optimization descent step (NaN on the initial solve)
+  double field_ms = kNaN;
+  double param_ms = kNaN;
+  double extract_ms = kNaN;
+  double metrics_ms = kNaN;
+  double quads_ms = kNaN;  //!< quad-mesh build (NaN when not built in this step)
+  double total_ms = kNaN;
+};
+
+//! Node positions (3D, on the job's surface) after one step; ids and positions are parallel.
+struct NodeFrame {
+  std::vector<int> ids;
+  std::vector<std::array<float, 3>> positions;
+};
+
+//! A quad mesh built on the worker, for drawing as a line overlay.
+struct QuadOverlay {
+  double quad_size = 0;  //!< q used
+  std::vector<std::array<float, 3>> vertices;
+  std::vector<std::array<int, 4>> quads;
+  int gridded_patches = 0;
+  int patches = 0;
+  std::vector<std::string> warnings;
+};
+
+//! Immutable job data the exporters need (defined by the job that fills it, e.g. the editor's
+//! pipeline job); the worker only passes the pointer along.
+struct JobExports;
+
 struct Snapshot {
   std::uint64_t version = 0;      //!< publication counter (strictly increasing)
   std::uint64_t generation = 0;   //!< job generation this state belongs to
@@ -30,6 +69,16 @@ struct Snapshot {
   int iteration = 0;    //!< steps done in the current job
   double energy = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> energy_history;  //!< energy per step of the current job
+  double energy_init = std::numeric_limits<double>::quiet_NaN();  //!< E of the first step
+
+  //! Metrics and timings of the latest step that measured them.
+  StepMetrics metrics;
+  //! Node positions per step of the current job (index = step - 1); entries are shared.
+  std::vector<std::shared_ptr<const NodeFrame>> node_history;
+  //! Quad mesh of the current job (null until a step built one).
+  std::shared_ptr<const QuadOverlay> quads;
+  //! Data for the exporters (null until a step provided it).
+  std::shared_ptr<const JobExports> exports;
 
   //! The mesh the job works on (shared, immutable); null before LoadMesh.
   std::shared_ptr<const TriMesh> mesh;

@@ -150,6 +150,11 @@ void Worker::run(std::stop_token stop) {
     current.iteration = 0;
     current.energy = std::numeric_limits<double>::quiet_NaN();
     current.energy_history.clear();
+    current.energy_init = std::numeric_limits<double>::quiet_NaN();
+    current.metrics = StepMetrics{};
+    current.node_history.clear();
+    current.quads.reset();
+    current.exports.reset();
     current.corner_uv.clear();
     current.face_foldover.clear();
   };
@@ -271,7 +276,12 @@ void Worker::run(std::stop_token stop) {
       current.generation = job_generation;
       current.iteration = state.iteration;
       current.energy = result.energy;
+      if (current.energy_history.empty()) current.energy_init = result.energy;
       current.energy_history.push_back(result.energy);
+      if (result.metrics.valid) current.metrics = result.metrics;
+      if (result.nodes) current.node_history.push_back(std::move(result.nodes));
+      if (result.quads) current.quads = std::move(result.quads);
+      if (result.exports) current.exports = std::move(result.exports);
       if (!result.message.empty()) current.message = result.message;
       if (!result.corner_uv.empty()) current.corner_uv = std::move(result.corner_uv);
       if (!result.face_foldover.empty()) current.face_foldover = std::move(result.face_foldover);

@@ -76,6 +76,10 @@ struct StepResult {
   double energy = std::numeric_limits<double>::quiet_NaN();
   std::vector<std::array<float, 2>> corner_uv;
   std::vector<char> face_foldover;
+  StepMetrics metrics;                        //!< copied when metrics.valid
+  std::shared_ptr<const NodeFrame> nodes;     //!< appended to Snapshot::node_history
+  std::shared_ptr<const QuadOverlay> quads;   //!< replaces Snapshot::quads when set
+  std::shared_ptr<const JobExports> exports;  //!< replaces Snapshot::exports when set
   bool validate = true;  //!< run validate_layout on the state's layout for the snapshot
 };
 

@@ -10,6 +10,11 @@ if(TARGET layout_editor_test)
     ${PROJECT_SOURCE_DIR}/app/gui/recent_files.cpp)
 endif()
 
+# gui_job_test.cpp: the editor's worker job (GL-free) on the bundled example.
+if(TARGET gui_job_test)
+  target_sources(gui_job_test PRIVATE ${PROJECT_SOURCE_DIR}/app/gui/pipeline_job.cpp)
+endif()
+
 if(NOT QS_BUILD_APP)
   return()
 endif()

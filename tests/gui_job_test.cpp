@@ -1,0 +1,104 @@
+// The editor's worker job (app/gui/pipeline_job.cpp) on the bundled example, GL-free: metrics,
+// timings and node positions per step, the quad mesh at the final step, and the exports.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+
+#include "app/gui/history.h"
+#include "app/gui/pipeline_job.h"
+#include "core/layout/layout_io.h"
+#include "core/mesh/mesh_io.h"
+
+namespace qs::app {
+namespace {
+
+using namespace std::chrono_literals;
+namespace fs = std::filesystem;
+
+struct Example {
+  std::shared_ptr<const TriMesh> mesh;
+  Layout layout;
+};
+
+Example example() {
+  const fs::path dir = fs::path(QS_ASSETS_DIR) / "example";
+  auto mesh = std::make_shared<TriMesh>(load_mesh((dir / "ellipsoid.obj").string()));
+  Layout layout = load_layout((dir / "ellipsoid.layout.json").string(), *mesh);
+  return {mesh, std::move(layout)};
+}
+
+TEST(GuiJob, StreamsMetricsHistoryQuadsAndExports) {
+  const Example ex = example();
+  Worker worker(pipeline_step);
+  WorkerOptions options;
+  options.max_steps = 2;  // initial solve + one node-optimization step
+  options.publish_interval_ms = 0;
+  worker.send(cmd::SetOptions{options});
+  worker.send(cmd::LoadMesh{ex.mesh, ex.layout});
+  worker.send(cmd::Run{});
+  const auto s = worker.wait_for(
+      [](const Snapshot& x) {
+        return x.status == WorkerStatus::Finished || x.status == WorkerStatus::Failed;
+      },
+      120s);
+  ASSERT_EQ(s->status, WorkerStatus::Finished) << s->message;
+  ASSERT_EQ(s->iteration, 2);
+
+  // Metrics and timings of the last step.
+  EXPECT_TRUE(std::isfinite(s->energy_init));
+  ASSERT_TRUE(s->metrics.valid);
+  EXPECT_TRUE(std::isfinite(s->metrics.E));
+  EXPECT_GE(s->metrics.E_confor, 2.0 - 1e-9);
+  EXPECT_GE(s->metrics.E_angle_deg, 0.0);
+  EXPECT_LE(s->metrics.E_angle_deg, 45.0 + 1e-9);
+  EXPECT_TRUE(std::isfinite(s->metrics.E_planar));
+  EXPECT_GE(s->metrics.foldovers, 0);
+  EXPECT_GE(s->metrics.field_ms, 0.0);
+  EXPECT_GE(s->metrics.param_ms, 0.0);
+  EXPECT_GE(s->metrics.nodeopt_ms, 0.0);  // a node-optimization step
+  EXPECT_GE(s->metrics.total_ms, s->metrics.param_ms);
+
+  // One node frame per step, one position per layout node.
+  ASSERT_EQ(s->node_history.size(), 2u);
+  for (const auto& frame : s->node_history) {
+    ASSERT_TRUE(frame);
+    EXPECT_EQ(frame->ids.size(), ex.layout.nodes.size());
+    EXPECT_EQ(frame->positions.size(), frame->ids.size());
+  }
+  EXPECT_EQ(scrub_index(5, int(s->node_history.size()), false), 1);
+
+  // Quad mesh built at the final step, on the worker.
+  ASSERT_TRUE(s->quads) << s->message;
+  EXPECT_GT(s->quads->quads.size(), 0u);
+  EXPECT_GT(s->quads->quad_size, 0.0);
+  for (const auto& q : s->quads->quads)
+    for (int v : q) ASSERT_TRUE(v >= 0 && v < int(s->quads->vertices.size()));
+
+  // Exports from the immutable snapshot data.
+  ASSERT_TRUE(s->exports);
+  const fs::path dir = fs::temp_directory_path() / "qs_gui_job_test_exports";
+  fs::remove_all(dir);
+  const auto written = write_job_exports(*s->exports, dir.string(), ExportSelection{});
+  EXPECT_EQ(written.size(), 5u);
+  for (const char* name :
+       {"param.obj", "layout.json", "quads.obj", "patches.json", "layout_curves.obj"}) {
+    EXPECT_TRUE(fs::exists(dir / name)) << name;
+    EXPECT_GT(fs::file_size(dir / name), 0u) << name;
+  }
+  // The written layout loads back on the job's mesh.
+  EXPECT_NO_THROW(load_layout((dir / "layout.json").string(), s->exports->mesh));
+  EXPECT_THROW(write_job_exports(*s->exports, "", ExportSelection{}), std::exception);
+  fs::remove_all(dir);
+}
+
+TEST(GuiJob, ExportWithoutQuadMeshFailsClearly) {
+  JobExports data;
+  EXPECT_THROW(write_job_exports(data, (fs::temp_directory_path() / "qs_gui_job_noquads").string(),
+                                 ExportSelection{false, false, true}),
+               std::exception);
+}
+
+}  // namespace
+}  // namespace qs::app
