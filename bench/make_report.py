@@ -115,7 +115,8 @@ def table1_row(label, run):
     node = rep.get("node_optimization", {}) if ok else {}
     E_init = rep.get("E_init") if ok else (run["log_steps"][0]["E"] if run and run["log_steps"]
                                           else None)
-    E_final = rep.get("E_final") if ok else None
+    accepted = [s["E"] for s in (run["log_steps"] if run else []) if s["accepted"]]
+    E_final = rep.get("E_final") if ok else (accepted[-1] if accepted else None)
     fold_before = node.get("foldovers_init") if ok else (
         run["log_steps"][0]["foldovers"] if run and run["log_steps"] else None)
     if ok and not node:
@@ -226,19 +227,21 @@ def main():
           "listed as its perturbed version). Each run is capped with `timeout`; a capped run is "
           "reported as such with the steps it printed before the cap.", ""]
 
-    node_opt = [m for m in models if m + ".opt" in runs]
-    no_node_opt = [m for m in models if m not in node_opt]
-    md += ["Scope of this run: node optimization (continuous and discrete) on "
-           f"{', '.join(node_opt) or 'no model'}; "
-           f"`--no-node-opt` only on {', '.join(no_node_opt) or 'no model'} (their "
-           "parameterization alone takes tens of seconds on 2 cores, so node optimization does "
-           "not fit the caps); models not listed were not run (`--models` selects them).", ""]
+    full = [m for m in models if m + ".opt" in runs]
+    pert = [m for m in models if m not in full and m + ".perturbed.opt" in runs]
+    none = [m for m in models if m not in full and m not in pert]
+    md += ["Scope of this run: node optimization of both layouts and discrete relocation on "
+           f"{', '.join(full) or 'no model'}; node optimization of the perturbed layout only on "
+           f"{', '.join(pert) or 'no model'}; `--no-node-opt` only on "
+           f"{', '.join(none) or 'no model'} (too large for the caps on 2 cores). Models not "
+           "listed were not run (`--models` selects them).", ""]
 
     # Table 1 analogue.
     md += ["## Table 1 analogue: node optimization", "",
            "Continuous relocation with the estimator gradient (`optimize`), time = total "
            "command time (s). Fold-overs: before node optimization → in the final "
-           "parameterization. Joint: `--no-node-opt` only (3751 nodes).", "",
+           "parameterization. A capped run shows the last accepted E it printed before the "
+           "cap (its final fold-overs are unknown).", "",
            "| model | faces | patches | time (s) | E_init | E_final | fold-overs | steps | "
            "status |", "|---|---|---|---|---|---|---|---|---|"]
     for m in models:
@@ -291,7 +294,9 @@ def main():
             return r["wall_s"] if r else None
         rc = c["report"] if c and c["report"] and c["report"].get("status") == "ok" else {}
         E0 = rc.get("E_init") if rc else None
-        dcap = " (last accepted E before the cap)" if d["capped"] else ""
+        dcap = ""
+        if d["capped"]:
+            dcap = " (last accepted E before the cap)" if final(d) else " (no step within the cap)"
         md.append(f"| {m} | {fmt(E0)} | {fmt(final(c))} | {len(steps_of(c))} | {fmt(t(c))} | "
                   f"{fmt(final(d))}{dcap} | {len(steps_of(d))} | {fmt(t(d))} | {status(d)} |")
     md.append("")

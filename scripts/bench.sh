@@ -7,15 +7,14 @@
 #   scripts/bench.sh [--models "spot fandisk ..."] [--steps N] [--no-micro] [--no-build]
 #
 # Environment: QS_BENCH_BUILD (build folder, default build), QS_BENCH_OUT (default out/bench),
-# QS_SHARED_DIR (default ../shared). Models: ellipsoid spot fandisk pig cow cat joint (the
-# default leaves out cow and cat to stay under 20 minutes on 2 cores). Caps in seconds:
-# QS_BENCH_OPT_CAP (node optimization, default 150), QS_BENCH_DISCRETE_CAP (discrete
-# relocation, default 90), QS_BENCH_CAP (other runs, default 120).
+# QS_SHARED_DIR (default ../shared). Models (all by default): ellipsoid spot fandisk pig cow cat
+# joint. Caps in seconds: QS_BENCH_OPT_CAP (node optimization, default 150),
+# QS_BENCH_DISCRETE_CAP (discrete relocation, default 120), QS_BENCH_CAP (other runs, 120).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
 command_line="$( (env | grep -E '^QS_(BENCH_[A-Z_]+|SHARED_DIR)=' || true) | sort | tr '\n' ' ')scripts/bench.sh $*"
-models="ellipsoid spot fandisk pig joint"
+models="ellipsoid spot fandisk pig cow cat joint"
 steps=10
 micro=1
 do_build=1
@@ -33,7 +32,7 @@ build=${QS_BENCH_BUILD:-build}
 out=${QS_BENCH_OUT:-out/bench}
 shared=${QS_SHARED_DIR:-../shared}/data/meshes
 opt_cap=${QS_BENCH_OPT_CAP:-150}
-disc_cap=${QS_BENCH_DISCRETE_CAP:-90}
+disc_cap=${QS_BENCH_DISCRETE_CAP:-120}
 cap=${QS_BENCH_CAP:-120}
 t_start=$(date +%s)
 
@@ -84,7 +83,9 @@ run() {
   echo "bench: $name: exit $rc, $(awk "BEGIN{printf \"%.1f\", $t1 - $t0}") s" >&2
 }
 
-# optimize runs of one model: MODEL MESH LAYOUT PERTURBED_LAYOUT NODE_OPT(0/1)
+# optimize runs of one model: MODEL MESH LAYOUT PERTURBED_LAYOUT NODE_OPT, where NODE_OPT is
+# full (both layouts, and discrete relocation on the perturbed one), perturbed (continuous
+# relocation of the perturbed layout only) or none (--no-node-opt only).
 bench_model() {
   local model=$1 mesh=$2 layout=$3 perturbed=$4 node_opt=$5
   local r="$out/runs"
@@ -92,7 +93,7 @@ bench_model() {
     --out "$r/$model.align" --no-node-opt
   run "$model.noalign" "$cap" "$cli" optimize --mesh "$mesh" --layout "$layout" \
     --out "$r/$model.noalign" --no-node-opt --no-align
-  if [ "$node_opt" = 1 ]; then
+  if [ "$node_opt" = full ]; then
     run "$model.opt" "$opt_cap" "$cli" optimize --mesh "$mesh" --layout "$layout" \
       --out "$r/$model.opt" --steps "$steps"
     if [ -n "$perturbed" ]; then
@@ -102,6 +103,9 @@ bench_model() {
         --layout "$perturbed" --out "$r/$model.perturbed.discrete" --steps "$steps" \
         --discrete-relocation
     fi
+  elif [ "$node_opt" = perturbed ] && [ -n "$perturbed" ]; then
+    run "$model.perturbed.opt" "$opt_cap" "$cli" optimize --mesh "$mesh" --layout "$perturbed" \
+      --out "$r/$model.perturbed.opt" --steps "$steps"
   elif [ -n "$perturbed" ]; then
     run "$model.perturbed.align" "$cap" "$cli" optimize --mesh "$mesh" --layout "$perturbed" \
       --out "$r/$model.perturbed.align" --no-node-opt
@@ -123,7 +127,7 @@ for model in $models; do
   case "$model" in
     ellipsoid)  # bundled example: exact corners and the displaced sketch
       bench_model ellipsoid assets/example/ellipsoid.obj assets/example/ellipsoid_exact.layout.json \
-        assets/example/ellipsoid.layout.json 1 ;;
+        assets/example/ellipsoid.layout.json full ;;
     spot) import_model spot --quads "$shared/spot/spot_quadrangulated.obj" || continue ;;
     fandisk)
       import_model fandisk --quads "$shared/fandisk/fandisk_quads.off" \
@@ -140,10 +144,13 @@ for model in $models; do
     dir="$out/runs/$model.import"
     pert="$dir/perturbed.layout.json"
     [ -f "$pert" ] || pert=""
-    # Node optimization only where it fits the caps on a 2-core machine: the animals (--refine 3,
-    # ~40K faces, ~1K nodes) and joint (43K faces, 3751 nodes) get --no-node-opt runs only.
-    node_opt=0
-    case "$model" in spot|fandisk) node_opt=1 ;; esac
+    # Node optimization where it fits the caps on a 2-core machine: the animals (--refine 3,
+    # ~40K faces, ~1K nodes) only on their perturbed layout; joint (43K faces, 3751 nodes) not.
+    case "$model" in
+      spot|fandisk) node_opt=full ;;
+      pig|cow|cat) node_opt=perturbed ;;
+      *) node_opt=none ;;
+    esac
     bench_model "$model" "$dir/mesh.obj" "$dir/layout.json" "$pert" "$node_opt"
   fi
 done

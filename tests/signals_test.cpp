@@ -140,6 +140,10 @@ RunOutcome run_and_signal(const std::string& out, int signo, std::chrono::millis
   EXPECT_GT(pid, 0);
   RunOutcome r;
   if (pid <= 0) return r;
+  // Count the delay from the moment the run has started working (it creates its output
+  // folder first), not from the spawn: on a loaded machine start-up alone can take a second.
+  for (int i = 0; i < 6000 && !std::filesystem::exists(out); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
   std::this_thread::sleep_for(delay);
   kill(pid, signo);
   r.exit_code = wait_exit(pid, 120s);

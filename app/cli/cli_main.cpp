@@ -9,6 +9,8 @@
 #include "core/base/errors.h"
 
 int main(int argc, char** argv) {
+  // First of all, so that a signal during start-up is never handled by the default action.
+  qs::cli::install_signal_handlers();  // SIGINT/SIGTERM: cancel, report.json "cancelled", 130/143
   using namespace qs::cli;
   CLI::App app{"QuadSketch: quad layout embedding via aligned parameterization (headless)",
                "quadsketch-cli"};
@@ -88,7 +90,6 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : 1;
   }
 
-  install_signal_handlers();  // SIGINT/SIGTERM: cancel, report.json "cancelled", 130/143
   try {
     if (*cmd_validate) return run_validate(validate, common);
     if (*cmd_field) return run_field(field, common);

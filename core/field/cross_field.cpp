@@ -158,7 +158,15 @@ CrossFieldSolver::CrossFieldSolver(const TriMesh& mesh, const GeometryCache& g,
   solver_.factorize(L);
   solve(g);
   // Drop constraint clusters that contradict the layout's topology, then re-solve.
-  for (int pass = 0; pass < options.max_conflict_passes && nc > 0; ++pass) {
+  int rings = options.conflict_rings;
+  auto count_mismatches = [&] {
+    const std::vector<int> m = principal_matching(g, field_.theta);
+    int bad = 0;
+    for (int e = 0; e < g.n_edges; ++e) bad += interior(g, e) && m[e] != field_.period_jump[e];
+    return bad;
+  };
+  int mismatches = count_mismatches();
+  for (int pass = 0; pass < options.max_conflict_passes && nc > 0 && mismatches > 0; ++pass) {
     const std::vector<int> matching = principal_matching(g, field_.theta);
     std::vector<int> dist(nf, -1);
     std::deque<int> queue;
@@ -176,7 +184,7 @@ CrossFieldSolver::CrossFieldSolver(const TriMesh& mesh, const GeometryCache& g,
       if (k >= 0 && cluster_active_[cluster_of_[k]] &&
           std::find(drop.begin(), drop.end(), cluster_of_[k]) == drop.end())
         drop.push_back(cluster_of_[k]);
-      if (dist[f] >= options.conflict_rings) continue;
+      if (dist[f] >= rings) continue;
       for (auto h : mesh.fh_range(mesh.face_handle(f))) {
         const auto opp = mesh.opposite_halfedge_handle(h);
         if (mesh.is_boundary(opp)) continue;
@@ -184,7 +192,13 @@ CrossFieldSolver::CrossFieldSolver(const TriMesh& mesh, const GeometryCache& g,
         if (dist[f2] < 0) dist[f2] = dist[f] + 1, queue.push_back(f2);
       }
     }
-    if (drop.empty()) break;
+    if (drop.empty()) {
+      // The conflicting clusters are farther away: widen the search (bounded).
+      if (rings >= 64 * options.conflict_rings) break;
+      rings *= 4;
+      --pass;
+      continue;
+    }
     for (int cl : drop) {
       cluster_active_[cl] = 0;
       ++field_.dropped_clusters;
@@ -207,6 +221,24 @@ CrossFieldSolver::CrossFieldSolver(const TriMesh& mesh, const GeometryCache& g,
     }
     solver_.factorize(L);
     solve(g);
+    const int now = count_mismatches();
+    if (now >= mismatches) {
+      // Dropping did not help: these steps are not caused by constraints (e.g. the smoothest
+      // field itself turns by more than 45° across an edge). Restore the clusters and stop.
+      for (int cl : drop) {
+        cluster_active_[cl] = 1;
+        --field_.dropped_clusters;
+      }
+      for (int k = 0; k < nc; ++k) {
+        if (std::find(drop.begin(), drop.end(), cluster_of_[k]) == drop.end()) continue;
+        L.coeffRef(field_.constraints.face[k], field_.constraints.face[k]) += lambda;
+        --field_.dropped_constraints;
+      }
+      solver_.factorize(L);
+      solve(g);
+      break;
+    }
+    mismatches = now;
   }
   field_.active_constraints = nc - field_.dropped_constraints;
   field_.timings.factorize_s = seconds_since(t0);
