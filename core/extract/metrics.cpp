@@ -15,15 +15,9 @@ ParamMetrics compute_metrics(const TriMesh& mesh, const GeometryCache& g, const 
     return std::abs(std::remainder(a, M_PI / 2)) * 180.0 / M_PI;
   };
   for (int f = 0; f < g.n_faces; ++f) {
-    const auto& fv = g.face_vertices[f];
-    const Vec3& r = g.face_frame[f];
-    const Vec3 s = g.face_normal[f] % r;
-    const Vec3 x0 = mesh.point(mesh.vertex_handle(fv[0]));
+    const auto corners = face_corners_2d(mesh, g, f);
     Eigen::Vector2d p[3];
-    for (int k = 0; k < 3; ++k) {
-      const Vec3 d = mesh.point(mesh.vertex_handle(fv[k])) - x0;
-      p[k] = Eigen::Vector2d(d | r, d | s);
-    }
+    for (int c = 0; c < 3; ++c) p[c] = Eigen::Vector2d(corners[c][0], corners[c][1]);
     Eigen::Matrix2d E3, Euv;
     E3.col(0) = p[1] - p[0];
     E3.col(1) = p[2] - p[0];
@@ -41,7 +35,8 @@ ParamMetrics compute_metrics(const TriMesh& mesh, const GeometryCache& g, const 
       confor += a * 1e6;
     const Eigen::Vector2d gu = J.row(0).transpose(), gv = J.row(1).transpose();
     const Vec3& d1 = curv.dir_max[f];
-    const Eigen::Vector2d d(d1 | r, d1 | s);
+    const Vec3& r = g.face_frame[f];
+    const Eigen::Vector2d d(d1 | r, d1 | (g.face_normal[f] % r));
     const double w = std::pow(curv.k_max[f] - curv.k_min[f], 2);
     angle_num += a * w * 0.5 * (deviation_deg(gu, d) + deviation_deg(gv, d));
     angle_den += a * w;

@@ -5,6 +5,20 @@
 
 namespace qs {
 
+std::array<std::array<double, 2>, 3> face_corners_2d(const TriMesh& mesh, const GeometryCache& g,
+                                                     int f) {
+  const auto& fv = g.face_vertices[f];
+  const Vec3& r = g.face_frame[f];
+  const Vec3 s = g.face_normal[f] % r;
+  const Vec3 x0 = mesh.point(mesh.vertex_handle(fv[0]));
+  std::array<std::array<double, 2>, 3> p{};
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 d = mesh.point(mesh.vertex_handle(fv[k])) - x0;
+    p[k] = {d | r, d | s};
+  }
+  return p;
+}
+
 double wrap_angle(double a) {
   a = std::remainder(a, 2 * M_PI);  // [−π, π]
   if (a <= -M_PI) a += 2 * M_PI;

@@ -53,6 +53,11 @@ GeometryCache build_geometry(const TriMesh& mesh);
 //! continuing κ (κ_new = κ_old + wrap(κ_new − κ_old), never re-wrapped; algorithm.md §6.1).
 void update_geometry(const TriMesh& mesh, GeometryCache& geometry);
 
+//! Corner positions of face f in its local 2D frame (r_f, n_f × r_f), corner 0 at the origin;
+//! the frame every per-face gradient (energy, metrics, node gradient) is expressed in.
+std::array<std::array<double, 2>, 3> face_corners_2d(const TriMesh& mesh,
+                                                     const GeometryCache& geometry, int f);
+
 //! Sets the frame offsets and recomputes frames and κ from scratch (not continued).
 void set_frame_offsets(const TriMesh& mesh, GeometryCache& geometry, std::vector<double> offsets);
 

@@ -12,15 +12,9 @@ namespace {
 Vec3 face_corner_gradient(const TriMesh& mesh, const GeometryCache& g, double theta,
                           const std::vector<std::array<double, 2>>& uv, double aniso, double weight,
                           int f, int k) {
-  const auto& fv = g.face_vertices[f];
-  const Vec3& r = g.face_frame[f];
-  const Vec3 s = g.face_normal[f] % r;
-  const Vec3 x0 = mesh.point(mesh.vertex_handle(fv[0]));
+  const auto corners = face_corners_2d(mesh, g, f);
   Eigen::Vector2d p[3];
-  for (int i = 0; i < 3; ++i) {
-    const Vec3 d = mesh.point(mesh.vertex_handle(fv[i])) - x0;
-    p[i] = Eigen::Vector2d(d | r, d | s);
-  }
+  for (int c = 0; c < 3; ++c) p[c] = Eigen::Vector2d(corners[c][0], corners[c][1]);
   const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
   const double a2 = (p[1] - p[0]).x() * (p[2] - p[0]).y() - (p[1] - p[0]).y() * (p[2] - p[0]).x();
   auto J = [](const Eigen::Vector2d& e) { return Eigen::Vector2d(-e.y(), e.x()); };
@@ -47,7 +41,8 @@ Vec3 face_corner_gradient(const TriMesh& mesh, const GeometryCache& g, double th
     total += (val[k1] - val[k2]) * (Jm.transpose() * Wr) + (0.5 * res.dot(Wr) - gr.dot(Wr)) * Je0;
   }
   total *= weight;
-  return total.x() * r + total.y() * s;
+  const Vec3& r = g.face_frame[f];
+  return total.x() * r + total.y() * (g.face_normal[f] % r);
 }
 
 }  // namespace

@@ -91,15 +91,9 @@ void compact(Terms& t) {
 // Local 2D gradient operator of face f: ∇φ_k (2D, in the frame r_f, n×r_f), and the area.
 void face_gradients(const TriMesh& mesh, const GeometryCache& g, int f,
                     Eigen::Matrix<double, 2, 3>& G, double& area) {
-  const auto& fv = g.face_vertices[f];
-  const Vec3& r = g.face_frame[f];
-  const Vec3 s = g.face_normal[f] % r;
-  const Vec3 x0 = mesh.point(mesh.vertex_handle(fv[0]));
+  const auto corners = face_corners_2d(mesh, g, f);
   Eigen::Vector2d p[3];
-  for (int k = 0; k < 3; ++k) {
-    const Vec3 d = mesh.point(mesh.vertex_handle(fv[k])) - x0;
-    p[k] = Eigen::Vector2d(d | r, d | s);
-  }
+  for (int c = 0; c < 3; ++c) p[c] = Eigen::Vector2d(corners[c][0], corners[c][1]);
   const Eigen::Vector2d e1 = p[1] - p[0], e2 = p[2] - p[0];
   const double a2 = e1.x() * e2.y() - e1.y() * e2.x();  // 2A
   area = 0.5 * a2;
