@@ -53,7 +53,11 @@ def steps_from_log(path):
 
 def collect(runs_dir):
     runs = {}
-    for name in sorted(os.listdir(runs_dir)):
+    # In the order the runs ended (run.json is written last).
+    names = sorted(os.listdir(runs_dir),
+                   key=lambda n: os.path.getmtime(os.path.join(runs_dir, n, "run.json"))
+                   if os.path.exists(os.path.join(runs_dir, n, "run.json")) else 0)
+    for name in names:
         d = os.path.join(runs_dir, name)
         run = load_json(os.path.join(d, "run.json"))
         if run is None:
@@ -108,7 +112,8 @@ def energies(run):
     return series
 
 
-def table1_row(label, run):
+def table1_row(label, run, model_run=None):
+    """model_run: a finished run on the same mesh, for faces and patches of a capped run."""
     rep = run["report"] if run else None
     ok = rep is not None and rep.get("status") == "ok"
     steps = steps_of(run)
@@ -122,8 +127,10 @@ def table1_row(label, run):
     if ok and not node:
         fold_before = rep["metrics"]["foldovers"]
     fold_after = rep["metrics"]["foldovers"] if ok else None
-    faces = rep["mesh"]["faces"] if ok else None
-    patches = rep["layout"]["patches"] if ok else None
+    src = rep if ok else (model_run["report"] if model_run and model_run["report"] and
+                          model_run["report"].get("status") == "ok" else None)
+    faces = src["mesh"]["faces"] if src else None
+    patches = src["layout"]["patches"] if src else None
     t = rep["timings_s"]["total"] if ok else (run["wall_s"] if run else None)
     return (f"| {label} | {fmt(faces)} | {fmt(patches)} | {fmt(t)} | {fmt(E_init)} | "
             f"{fmt(E_final)} | {fmt(fold_before)} → {fmt(fold_after)} | {len(steps)} | "
@@ -216,7 +223,7 @@ def main():
           f"- Memory: {machine['memory']}",
           f"- Load average at the end of the run: {machine['load']} (the machine is shared: "
           "wall times include contention)",
-          f"- Date: {machine['date']}",
+          f"- Date (start of the run): {machine['date']}",
           f"- Git commit: {machine['commit']}",
           f"- Command: `{machine['command']}`",
           f"- Total runtime of the command: {machine['runtime_s']} s", "",
@@ -245,14 +252,14 @@ def main():
            "| model | faces | patches | time (s) | E_init | E_final | fold-overs | steps | "
            "status |", "|---|---|---|---|---|---|---|---|---|"]
     for m in models:
-        for suffix, label in ((".opt", m), (".perturbed.opt", m + " + perturb"),
-                              (".align", m + " (no node opt)"),
+        for suffix, label in ((".opt", m), (".align", m + " (no node opt)"),
+                              (".perturbed.opt", m + " + perturb"),
                               (".perturbed.align", m + " + perturb (no node opt)")):
-            if suffix.endswith("align") and (m + ".opt") in runs:
+            if suffix == ".align" and (m + ".opt") in runs:
                 continue
             run = runs.get(m + suffix)
             if run:
-                md.append(table1_row(label, run))
+                md.append(table1_row(label, run, runs.get(m + ".align")))
     md.append("")
 
     # §9.1 aligned vs not.

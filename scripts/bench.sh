@@ -35,17 +35,17 @@ opt_cap=${QS_BENCH_OPT_CAP:-150}
 disc_cap=${QS_BENCH_DISCRETE_CAP:-120}
 cap=${QS_BENCH_CAP:-120}
 t_start=$(date +%s)
+# The commit is taken before the build: the binaries are built from this working tree.
+commit="$(git rev-parse --short HEAD 2>/dev/null || echo unknown)"
+[ -n "$(git status --porcelain --untracked-files=no 2>/dev/null)" ] &&
+  commit="$commit (with uncommitted changes)"
 
 if [ ! -x /usr/bin/time ]; then
   echo "bench.sh: /usr/bin/time is missing (Debian package 'time'); peak memory not measured" >&2
 fi
 
 # --- build ---------------------------------------------------------------------------------
-# Until the top-level CMakeLists.txt has add_subdirectory(bench), bench/inject.cmake adds it.
 cmake_args=(-DCMAKE_BUILD_TYPE=Release)
-if ! grep -q 'add_subdirectory(bench)' CMakeLists.txt; then
-  cmake_args+=(-DCMAKE_PROJECT_INCLUDE="$root/bench/inject.cmake")
-fi
 if [ "$do_build" = 0 ]; then
   :
 elif [ ! -f "$build/CMakeCache.txt" ]; then
@@ -164,7 +164,7 @@ fi
 
 t_end=$(date +%s)
 machine_json=$(
-  python3 - "$t_start" "$t_end" "$command_line" <<'EOF'
+  python3 - "$t_start" "$t_end" "$command_line" "$commit" <<'EOF'
 import json, subprocess, sys
 def sh(c):
     try:
@@ -176,8 +176,8 @@ print(json.dumps({
     "cpu": sh("lscpu | grep 'Model name' | sed 's/Model name: *//'"),
     "memory": sh("free -h | awk '/^Mem:/ {print $2}'"),
     "load": sh("cut -d' ' -f1-3 /proc/loadavg"),
-    "date": sh("date -u '+%Y-%m-%d %H:%M UTC'"),
-    "commit": sh("git rev-parse --short HEAD") + (" (uncommitted changes)" if sh("git status --porcelain --untracked-files=no") else ""),
+    "date": sh("date -u -d @" + sys.argv[1] + " '+%Y-%m-%d %H:%M UTC'"),
+    "commit": sys.argv[4],
     "command": sys.argv[3],
     "runtime_s": int(sys.argv[2]) - int(sys.argv[1]),
 }))

@@ -22,11 +22,16 @@ if [ ! -f "$build/CMakeCache.txt" ]; then
 fi
 cmake --build "$build" -j"$(nproc)" --target "${targets[@]}"
 
-seeds() {  # target -> seed files and folders
+seeds() {  # target -> seed files
+  local f
   case "$1" in
-    layout_fuzzer) ls assets/example/*.layout.json assets/bad/*.layout.json ;;
-    mesh_fuzzer) ls assets/bad/* fuzz/corpus/quads/* | grep -v -e '\.json$' -e 'README' ;;
-    quads_fuzzer) ls fuzz/corpus/quads/* assets/bad/*.obj assets/bad/*.off ;;
+    layout_fuzzer) printf '%s\n' assets/example/*.layout.json assets/bad/*.layout.json ;;
+    mesh_fuzzer)
+      for f in assets/bad/* fuzz/corpus/quads/*; do
+        case "$f" in *.json | *README*) ;; *) echo "$f" ;; esac
+      done
+      ;;
+    quads_fuzzer) printf '%s\n' fuzz/corpus/quads/* assets/bad/*.obj assets/bad/*.off ;;
   esac
 }
 

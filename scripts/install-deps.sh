@@ -5,7 +5,7 @@ set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 PACKAGES=(
-  build-essential cmake ninja-build pkg-config git
+  build-essential cmake ninja-build pkg-config git time python3
   libopenmesh-dev libeigen3-dev libsuitesparse-dev libopenblas-dev
   libglfw3-dev libglm-dev libimgui-dev libstb-dev
   nlohmann-json3-dev libcli11-dev libgtest-dev libbenchmark-dev
