@@ -90,6 +90,9 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : 1;
   }
 
+  // field and optimize stop cooperatively (report.json "cancelled", see report.h); the other
+  // commands are short and write atomically: a signal simply ends them.
+  if (!*cmd_field && !*cmd_opt) restore_default_signal_handling();
   try {
     if (*cmd_validate) return run_validate(validate, common);
     if (*cmd_field) return run_field(field, common);

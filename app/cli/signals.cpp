@@ -38,6 +38,16 @@ void install_signal_handlers() {
   sigaction(SIGTERM, &action, nullptr);
 }
 
+void restore_default_signal_handling() {
+  struct sigaction action {};
+  action.sa_handler = SIG_DFL;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+  // A signal that arrived during start-up is honoured now.
+  if (const int signo = received_signal()) std::raise(signo);
+}
+
 int received_signal() {
   return g_signal.load(std::memory_order_relaxed);
 }

@@ -18,6 +18,10 @@ namespace qs::cli {
 //! Installs the SIGINT and SIGTERM handlers (once; later calls do nothing).
 void install_signal_handlers();
 
+//! Gives SIGINT/SIGTERM back their default action (immediate termination), for commands that
+//! do not poll for cancellation; their outputs are written atomically, so nothing tears.
+void restore_default_signal_handling();
+
 //! The signal received (SIGINT, SIGTERM), or 0. Async-signal-safe to call.
 int received_signal();
 
