@@ -1,6 +1,7 @@
 #include "tests/fixtures.h"
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cmath>
@@ -26,7 +27,10 @@ std::string cli_path() {
 }
 
 std::string temp_dir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("qs_test_" + name);
+  // One folder per test process: CTest runs tests in parallel processes, and a shared fixed
+  // path would let one test wipe another's files.
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("qs_test_" + name + "_" + std::to_string(getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();

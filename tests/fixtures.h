@@ -14,7 +14,7 @@ std::string shared_meshes_dir();
 std::string assets_dir();
 //! Path of the quadsketch-cli executable.
 std::string cli_path();
-//! A fresh empty temporary folder for one test (under the system temp dir).
+//! A fresh empty temporary folder for one test (under the system temp dir, unique per process).
 std::string temp_dir(const std::string& name);
 
 //! Runs a shell command, returns its exit code and captures stdout+stderr into \p output.
