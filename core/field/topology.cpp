@@ -151,8 +151,9 @@ struct CycleEquation {
   bool ok = false;
 };
 
-CycleEquation path_equation(const TriMesh& mesh, const GeometryCache& g, const std::vector<int>& path,
-                            long sectors_term, const std::string& name);
+CycleEquation path_equation(const TriMesh& mesh, const GeometryCache& g,
+                            const std::vector<int>& path, long sectors_term,
+                            const std::string& name);
 
 CycleEquation cycle_equation(const TriMesh& mesh, const GeometryCache& g, const Layout& layout,
                              const LayoutTopology& topo,
@@ -180,12 +181,14 @@ CycleEquation cycle_equation(const TriMesh& mesh, const GeometryCache& g, const 
     const int s = ((pos_in - pos_out) % val + val) % val;
     sectors_term += 2 - s;
   }
-  return path_equation(mesh, g, path, sectors_term, "layout cycle (arcs " + arc_list(layout, cycle) + ")");
+  return path_equation(mesh, g, path, sectors_term,
+                       "layout cycle (arcs " + arc_list(layout, cycle) + ")");
 }
 
 // Σ_Γ p = sectors_term − 4W for the closed vertex path, Γ its left face strip (§1.3).
-CycleEquation path_equation(const TriMesh& mesh, const GeometryCache& g, const std::vector<int>& path,
-                            long sectors_term, const std::string& name) {
+CycleEquation path_equation(const TriMesh& mesh, const GeometryCache& g,
+                            const std::vector<int>& path, long sectors_term,
+                            const std::string& name) {
   CycleEquation eq;
   const int len = static_cast<int>(path.size());
   double kappa_sum = 0, angle_term = 0;
@@ -241,28 +244,7 @@ std::vector<int> compute_period_jumps(const TriMesh& mesh, const GeometryCache& 
   const std::vector<int> target = target_quarter_indices(mesh, layout, topo);
 
   // 1. Dual spanning tree T* (BFS over faces); p = 0 on it.
-  std::vector<char> in_tstar(ne, 0);
-  {
-    std::vector<char> seen(nf, 0);
-    for (int root = 0; root < nf; ++root) {
-      if (seen[root]) continue;
-      seen[root] = 1;
-      std::deque<int> queue{root};
-      while (!queue.empty()) {
-        const int f = queue.front();
-        queue.pop_front();
-        for (auto h : mesh.fh_range(mesh.face_handle(f))) {
-          const auto opp = mesh.opposite_halfedge_handle(h);
-          if (mesh.is_boundary(opp)) continue;
-          const int f2 = mesh.face_handle(opp).idx();
-          if (seen[f2]) continue;
-          seen[f2] = 1;
-          in_tstar[mesh.edge_handle(h).idx()] = 1;
-          queue.push_back(f2);
-        }
-      }
-    }
-  }
+  const std::vector<char> in_tstar = dual_spanning_tree(mesh, [](int) { return true; });
 
   // 2. Primal graph: interior vertices and one virtual vertex per boundary loop.
   const auto loops = boundary_loops(mesh);

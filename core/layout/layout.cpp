@@ -10,6 +10,18 @@ int Layout::node_index(int id) const {
   return -1;
 }
 
+bool same_cycle(const std::vector<int>& a, const std::vector<int>& b) {
+  if (a.size() != b.size()) return false;
+  if (a.empty()) return true;
+  for (size_t shift = 0; shift < b.size(); ++shift) {
+    if (b[shift] != a[0]) continue;
+    bool equal = true;
+    for (size_t i = 0; i < a.size() && equal; ++i) equal = a[i] == b[(i + shift) % b.size()];
+    if (equal) return true;
+  }
+  return false;
+}
+
 int Layout::arc_index(int id) const {
   for (size_t i = 0; i < arcs.size(); ++i)
     if (arcs[i].id == id) return static_cast<int>(i);

@@ -113,6 +113,9 @@ inline int sigma(int h) {
 //! \pre every arc has a path of mesh edges between its end vertices; arcs are disjoint.
 LayoutTopology build_topology(const TriMesh& mesh, const Layout& layout);
 
+//! True when the two sequences are equal up to a cyclic rotation (cyclic orders of arcs).
+bool same_cycle(const std::vector<int>& a, const std::vector<int>& b);
+
 //! φ = θ∘σ. -1 when θ is undefined.
 inline int phi(const LayoutTopology& topo, int h) {
   return topo.theta[sigma(h)];

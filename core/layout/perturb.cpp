@@ -16,18 +16,6 @@ namespace {
 using HH = OpenMesh::HalfedgeHandle;
 using VH = OpenMesh::VertexHandle;
 
-bool same_cycle(const std::vector<int>& a, const std::vector<int>& b) {
-  if (a.size() != b.size()) return false;
-  if (a.empty()) return true;
-  for (size_t shift = 0; shift < b.size(); ++shift) {
-    if (b[shift] != a[0]) continue;
-    bool equal = true;
-    for (size_t i = 0; i < a.size() && equal; ++i) equal = a[i] == b[(i + shift) % b.size()];
-    if (equal) return true;
-  }
-  return false;
-}
-
 // Moves nodes one at a time, keeping incremental ownership maps so that each move costs time
 // proportional to the patches around the node, not to the whole mesh.
 class Perturber {

@@ -85,19 +85,6 @@ void require_valid(const TriMesh& mesh, const Layout& layout, const std::string&
   throw InvalidInputError(msg);
 }
 
-// True when the sequences are equal up to a cyclic rotation.
-bool same_cycle(const std::vector<int>& a, const std::vector<int>& b) {
-  if (a.size() != b.size()) return false;
-  if (a.empty()) return true;
-  for (size_t shift = 0; shift < b.size(); ++shift) {
-    if (b[shift] != a[0]) continue;
-    bool equal = true;
-    for (size_t i = 0; i < a.size() && equal; ++i) equal = a[i] == b[(i + shift) % b.size()];
-    if (equal) return true;
-  }
-  return false;
-}
-
 // Routes a quad complex onto a target triangle mesh (see transfer_complex).
 class Transfer {
  public:

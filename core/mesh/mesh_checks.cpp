@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <deque>
 #include <limits>
 #include <numeric>
 #include <utility>
@@ -429,6 +430,32 @@ std::vector<std::vector<int>> boundary_loops(const TriMesh& mesh) {
 
 std::vector<int> face_components(const TriMesh& mesh, int* count) {
   return components_of_faces(mesh, count);
+}
+
+std::vector<char> dual_spanning_tree(const TriMesh& mesh,
+                                     const std::function<bool(int)>& crossable) {
+  const int nf = static_cast<int>(mesh.n_faces());
+  std::vector<char> seen(nf, 0), tree(mesh.n_edges(), 0);
+  for (int root = 0; root < nf; ++root) {
+    if (seen[root]) continue;
+    seen[root] = 1;
+    std::deque<int> queue{root};
+    while (!queue.empty()) {
+      const int f = queue.front();
+      queue.pop_front();
+      for (auto h : mesh.fh_range(mesh.face_handle(f))) {
+        const int e = mesh.edge_handle(h).idx();
+        const auto opp = mesh.opposite_halfedge_handle(h);
+        if (mesh.is_boundary(opp) || !crossable(e)) continue;
+        const int f2 = mesh.face_handle(opp).idx();
+        if (seen[f2]) continue;
+        seen[f2] = 1;
+        tree[e] = 1;
+        queue.push_back(f2);
+      }
+    }
+  }
+  return tree;
 }
 
 }  // namespace qs

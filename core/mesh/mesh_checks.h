@@ -1,6 +1,7 @@
 // Topological and geometric checks of meshes (used by load_mesh and by the pipeline).
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include "core/mesh/mesh.h"
@@ -46,6 +47,12 @@ void count_topology(const MeshT& mesh, MeshReport& report);
 //! (i.e. along the non-boundary halfedges of the boundary edges). Each loop starts at its
 //! smallest vertex index and the loops are sorted, so the result depends only on the mesh.
 std::vector<std::vector<int>> boundary_loops(const TriMesh& mesh);
+
+//! Spanning forest of the dual graph by BFS from face 0 (then every unreached face), crossing
+//! only interior edges for which \p crossable(edge index) is true. Returns a flag per edge
+//! (size #E): 1 for the tree's edges.
+std::vector<char> dual_spanning_tree(const TriMesh& mesh,
+                                     const std::function<bool(int)>& crossable);
 
 //! Connected component id per face (size #F) and the number of components. Faces sharing a
 //! vertex are connected; ids are numbered in order of each component's first face.

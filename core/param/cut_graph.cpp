@@ -3,6 +3,8 @@
 #include <deque>
 #include <numeric>
 
+#include "core/mesh/mesh_checks.h"
+
 namespace qs {
 
 CutGraph build_cut_graph(const TriMesh& mesh, const GeometryCache& g, const std::vector<int>& p,
@@ -12,27 +14,7 @@ CutGraph build_cut_graph(const TriMesh& mesh, const GeometryCache& g, const std:
   cg.cut.assign(ne, 0);
   // Spanning tree of faces across identity-transition edges (BFS); every other interior edge
   // is cut. The period-jump tree of topology.cpp has p = 0, so every face is reached.
-  std::vector<char> seen(nf, 0), tree(ne, 0);
-  for (int root = 0; root < nf; ++root) {
-    if (seen[root]) continue;
-    seen[root] = 1;
-    std::deque<int> queue{root};
-    while (!queue.empty()) {
-      const int f = queue.front();
-      queue.pop_front();
-      for (auto h : mesh.fh_range(mesh.face_handle(f))) {
-        const int e = mesh.edge_handle(h).idx();
-        if (p[e] % 4 != 0) continue;
-        const auto opp = mesh.opposite_halfedge_handle(h);
-        if (mesh.is_boundary(opp)) continue;
-        const int f2 = mesh.face_handle(opp).idx();
-        if (seen[f2]) continue;
-        seen[f2] = 1;
-        tree[e] = 1;
-        queue.push_back(f2);
-      }
-    }
-  }
+  const std::vector<char> tree = dual_spanning_tree(mesh, [&](int e) { return p[e] % 4 == 0; });
   std::vector<int> valence(g.n_vertices, 0);
   for (int e = 0; e < ne; ++e) {
     if (g.edge_face_i[e] < 0 || g.edge_face_j[e] < 0 || tree[e]) continue;
