@@ -261,6 +261,14 @@ TEST_F(LayoutEditorTest, AutosaveIsValidJsonAfterAnEdit) {
   ASSERT_TRUE(offer.has_value());
   EXPECT_EQ(offer->path, autosave_path());
   EXPECT_FALSE(find_autosave((dir / "other.obj").string(), "").has_value());
+  // One file carries the layout and its description (a single atomic write), no sidecar.
+  EXPECT_EQ(json.at("autosave").at("mesh"), fs::weakly_canonical(mesh_file).string());
+  std::size_t files = 0;
+  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir)) ++files;
+  EXPECT_EQ(files, 2u);  // grid.obj and autosave.layout.json
+  // A torn or foreign file is never offered.
+  std::ofstream(autosave_path()) << "{ \"format\": \"quadsketch-layout\", \"nod";
+  EXPECT_FALSE(find_autosave(mesh_file.string(), "").has_value());
   fs::remove_all(dir);
 }
 

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/base/atomic_file.h"
+#include "core/base/errors.h"
 #include "core/layout/layout_io.h"
 
 namespace qs::app {
@@ -13,10 +14,6 @@ namespace qs::app {
 namespace fs = std::filesystem;
 
 namespace {
-
-fs::path meta_path() {
-  return autosave_dir() / "autosave.meta.json";
-}
 
 std::string absolute_string(const std::string& path) {
   if (path.empty()) return {};
@@ -43,14 +40,20 @@ fs::path autosave_path() {
 void write_autosave(const Layout& layout, const TriMesh* mesh, const std::string& mesh_path,
                     const std::string& layout_path) {
   fs::create_directories(autosave_dir());
-  save_layout(layout, autosave_path().string(), mesh);
   const std::time_t now = std::time(nullptr);
   char stamp[64] = "";
   std::strftime(stamp, sizeof(stamp), "%Y-%m-%d %H:%M:%S", std::localtime(&now));
   const nlohmann::json meta = {{"mesh", absolute_string(mesh_path)},
                                {"layout", absolute_string(layout_path)},
                                {"saved_at", stamp}};
-  write_file_atomic(meta_path().string(), meta.dump(2) + "\n");
+  // One file, one atomic write: the layout JSON with the "autosave" block as its first key
+  // (the layout reader ignores unknown keys), so a killed process can never leave a layout
+  // paired with another session's description.
+  std::string text = layout_to_json(layout, mesh);
+  const std::size_t brace = text.find('{');
+  if (brace == std::string::npos) throw QsError("autosave: unexpected layout serialization");
+  text.insert(brace + 1, "\n  \"autosave\": " + meta.dump() + ",");
+  write_file_atomic(autosave_path().string(), text);
 }
 
 std::optional<AutosaveOffer> find_autosave(const std::string& mesh_path,
@@ -58,8 +61,10 @@ std::optional<AutosaveOffer> find_autosave(const std::string& mesh_path,
   try {
     std::error_code ec;
     const fs::path autosave = autosave_path();
-    if (!fs::exists(autosave, ec) || !fs::exists(meta_path(), ec)) return std::nullopt;
-    const auto meta = nlohmann::json::parse(read_file(meta_path().string()));
+    if (!fs::exists(autosave, ec)) return std::nullopt;
+    const auto document = nlohmann::json::parse(read_file(autosave.string()));
+    if (!document.is_object() || !document.contains("autosave")) return std::nullopt;
+    const auto& meta = document.at("autosave");
     if (meta.value("mesh", std::string()) != absolute_string(mesh_path)) return std::nullopt;
     AutosaveOffer offer;
     offer.path = autosave;

@@ -1,5 +1,6 @@
 // Crash safety: after every edit the layout is written atomically to an autosave file, with
-// a small sidecar naming the mesh it belongs to, so that it can be offered back at start.
+// an "autosave" block naming the mesh it belongs to (one file, one atomic write), so that it can be
+// offered back at start.
 #pragma once
 
 #include <filesystem>
@@ -16,8 +17,9 @@ std::filesystem::path autosave_dir();
 //! autosave_dir()/autosave.layout.json
 std::filesystem::path autosave_path();
 
-//! Writes the layout (atomically) and the sidecar autosave.meta.json. \p mesh_path and
-//! \p layout_path are the files being edited. \throw QsError when the folder is not writable.
+//! Writes the layout with its "autosave" block (mesh, layout file, time) in one atomic write. \p
+//! mesh_path and \p layout_path are the files being edited. \throw QsError when the folder is not
+//! writable.
 void write_autosave(const Layout& layout, const TriMesh* mesh, const std::string& mesh_path,
                     const std::string& layout_path);
 
