@@ -1,6 +1,7 @@
 // Guiding cross field: topology fixed by the layout, smoothness, alignment (issue #3).
 #include <gtest/gtest.h>
 
+#include <Eigen/SparseCholesky>
 #include <cmath>
 #include <numeric>
 #include <random>
@@ -10,6 +11,7 @@
 #include "core/field/cross_field.h"
 #include "core/field/curvature.h"
 #include "core/field/topology.h"
+#include "core/layout/perturb.h"
 #include "core/layout/quad_import.h"
 #include "core/layout/validate.h"
 #include "core/mesh/geometry.h"
@@ -220,6 +222,159 @@ TEST(CrossField, ParallelToSharpFeatures) {
   }
   EXPECT_EQ(count, 12 * 6);
   EXPECT_LT(worst, 0.5);
+}
+
+// θ from a fresh sparse factorization of the solver's matrix with the right-hand side built here
+// from the given geometry and the solver's integer choices (period jumps, constraint rotations).
+// Valid when no constraint cluster was dropped (every constraint is then in force).
+std::vector<double> reference_theta(const GeometryCache& g, const CrossFieldSolver& solver,
+                                    double lambda = 100.0) {
+  const CrossField& f = solver.field();
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(g.n_faces);
+  for (int e = 0; e < g.n_edges; ++e) {
+    if (g.edge_face_i[e] < 0 || g.edge_face_j[e] < 0) continue;
+    const double k = g.kappa[e] + M_PI / 2 * f.period_jump[e];
+    b(g.edge_face_i[e]) -= k;
+    b(g.edge_face_j[e]) += k;
+  }
+  for (size_t k = 0; k < f.constraints.face.size(); ++k) {
+    const int face = f.constraints.face[k];
+    b(face) +=
+        lambda * (g.angle_in_face(face, f.constraints.direction[k]) + M_PI / 2 * f.constraint_q[k]);
+  }
+  // The matrix is symmetric; the solver stores its lower triangle.
+  const Eigen::SparseMatrix<double> lower = solver.matrix();
+  Eigen::SparseMatrix<double> full = lower.selfadjointView<Eigen::Lower>();
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(full);
+  EXPECT_EQ(ldlt.info(), Eigen::Success);
+  const Eigen::VectorXd x = ldlt.solve(b);
+  return std::vector<double>(x.data(), x.data() + x.size());
+}
+
+double max_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  EXPECT_EQ(a.size(), b.size());
+  double worst = 0;
+  for (size_t i = 0; i < a.size() && i < b.size(); ++i)
+    worst = std::max(worst, std::abs(a[i] - b[i]));
+  return worst;
+}
+
+TEST(CrossField, ResolveAfterMovingVerticesEqualsAFreshSolve) {
+  // The re-solve reuses the factorization and the integer choices; it must equal a fresh
+  // factorization of the system assembled for the moved geometry.
+  // A flattened ellipsoid: reliable curvature constraints in one cluster, none dropped.
+  auto in = test::cube_sphere(10, Vec3(1.3, 1.0, 0.5));
+  GeometryCache g = build_geometry(in.mesh);
+  const LayoutTopology topo = build_topology(in.mesh, in.layout);
+  CrossFieldSolver solver(in.mesh, g, in.layout, topo);
+  ASSERT_GT(solver.field().constraints.face.size(), 100u);
+  ASSERT_EQ(solver.field().dropped_clusters, 0);
+  const std::vector<double> before = solver.field().theta;
+  const int factorizations = solver.field().timings.factorizations;
+  // Move every node vertex and its neighbours by up to 2% of the radius.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> uni(-0.02, 0.02);
+  for (const auto& node : in.layout.nodes) {
+    const auto v = in.mesh.vertex_handle(node.vertex);
+    in.mesh.set_point(v, in.mesh.point(v) + Vec3(uni(rng), uni(rng), uni(rng)));
+    for (auto w : in.mesh.vv_range(v))
+      in.mesh.set_point(w, in.mesh.point(w) + Vec3(uni(rng), uni(rng), uni(rng)));
+  }
+  update_geometry(in.mesh, g);
+  const CrossField& f = solver.solve(g);
+  EXPECT_EQ(f.timings.factorizations, factorizations) << "a re-solve must not re-factorize";
+  EXPECT_GT(max_difference(f.theta, before), 1e-4) << "the geometry change must matter";
+  EXPECT_LT(max_difference(f.theta, reference_theta(g, solver)), 1e-9);
+  const auto idx = field_quarter_indices(g, f.theta);
+  EXPECT_EQ(std::count(idx.begin(), idx.end(), 1), 8);
+  EXPECT_EQ(std::count(idx.begin(), idx.end(), 0), static_cast<long>(idx.size()) - 8);
+}
+
+TEST(CrossField, UpdateLayoutEqualsAFreshSolver) {
+  // Nodes moved to other vertices (arcs re-routed): new period jumps, same matrix. The updated
+  // solver must give exactly what a solver built for the new layout gives.
+  const auto in = test::cube_sphere(10, Vec3(1.3, 1.0, 0.5));
+  const GeometryCache g = build_geometry(in.mesh);
+  const LayoutTopology topo = build_topology(in.mesh, in.layout);
+  CrossFieldSolver solver(in.mesh, g, in.layout, topo);
+  ASSERT_GT(solver.field().constraints.face.size(), 100u);
+  PerturbLayoutOptions popt;
+  popt.rings = 2;
+  popt.seed = 3;
+  const PerturbResult moved = perturb_layout(in.mesh, in.layout, popt);
+  ASSERT_GE(moved.moved_nodes.size(), 4u);
+  const LayoutTopology topo2 = build_topology(in.mesh, moved.layout);
+  const int factorizations = solver.field().timings.factorizations;
+  const std::vector<int> old_jumps = solver.field().period_jump;
+  const CrossField& updated = solver.update_layout(in.mesh, g, moved.layout, topo2);
+  EXPECT_EQ(updated.timings.factorizations, factorizations);
+  EXPECT_NE(updated.period_jump, old_jumps) << "moving singular nodes must change the jumps";
+  const CrossFieldSolver fresh(in.mesh, g, moved.layout, topo2);
+  ASSERT_EQ(fresh.field().dropped_clusters, 0);
+  ASSERT_EQ(updated.dropped_clusters, 0);
+  EXPECT_EQ(updated.period_jump, fresh.field().period_jump);
+  EXPECT_EQ(updated.constraint_q, fresh.field().constraint_q);
+  EXPECT_LT(max_difference(updated.theta, fresh.field().theta), 1e-9);
+  // The singularities followed the nodes.
+  const auto idx = field_quarter_indices(g, updated.theta);
+  for (const auto& node : moved.layout.nodes) EXPECT_EQ(idx[node.vertex], 1);
+  EXPECT_EQ(std::count(idx.begin(), idx.end(), 0), static_cast<long>(idx.size()) - 8);
+}
+
+TEST(CrossField, RelaxedWarmStartRoundsLikeTheLargestClusterWarmStart) {
+  // The relaxed warm start (no extra factorization) must pick the same cluster rotations as
+  // the largest-cluster warm start on models with several constraint clusters.
+  // Ellipsoids with two curvature clusters (kept, and both dropped as contradicting the cube
+  // layout), and spot (8 clusters, most dropped) when the shared meshes are present.
+  std::vector<test::MeshAndLayout> cases;
+  cases.push_back(test::cube_sphere(10, Vec3(1.6, 1.0, 0.75)));
+  cases.push_back(test::cube_sphere(10, Vec3(2.0, 1.0, 0.75)));
+  const std::string dir = test::shared_meshes_dir();
+  if (!dir.empty()) {
+    const PolyMesh quads = load_poly_mesh(dir + "/spot/spot_quadrangulated.obj");
+    const QuadImportResult imported = import_quads(quads, nullptr, QuadImportOptions{});
+    cases.push_back({imported.mesh, imported.layout});
+  } else {
+    std::printf("[note] ../shared/data/meshes is absent: spot case skipped\n");
+  }
+  int multi = 0;
+  for (const auto& in : cases) {
+    CrossFieldOptions relaxed, largest;
+    largest.warm_start = ClusterWarmStart::LargestCluster;
+    const Solved a = solve_field(in, 0, relaxed), b = solve_field(in, 0, largest);
+    multi += a.field.clusters > 1;
+    EXPECT_EQ(a.field.constraint_q, b.field.constraint_q);
+    EXPECT_EQ(a.field.dropped_clusters, b.field.dropped_clusters);
+    EXPECT_LT(max_difference(a.field.theta, b.field.theta), 1e-9);
+    EXPECT_LT(a.field.timings.factorizations, b.field.timings.factorizations + 1);
+  }
+  EXPECT_GE(multi, 2) << "the cases must exercise several clusters";
+}
+
+TEST(CrossField, FaceLocalConflictDropReleasesFewerConstraints) {
+  // On this ellipsoid both curvature clusters contradict the cube layout near its corners.
+  // Whole-cluster dropping releases every constraint; the experimental face-local mode only
+  // releases faces near the steep edges and must still remove every steep edge it can.
+  const auto in = test::cube_sphere(10, Vec3(2.0, 1.0, 0.75));
+  CrossFieldOptions faces;
+  faces.conflict_drop = ConflictDrop::Faces;
+  const Solved a = solve_field(in, 0, {}), b = solve_field(in, 0, faces);
+  ASSERT_GT(a.field.dropped_constraints, 0);
+  EXPECT_LT(b.field.dropped_constraints, a.field.dropped_constraints);
+  EXPECT_GT(b.field.active_constraints, 0);
+  int active = 0;
+  for (char c : b.field.constraint_active) active += c;
+  EXPECT_EQ(active, b.field.active_constraints);
+  auto steep = [](const Solved& s) {
+    const auto m = principal_matching(s.geometry, s.field.theta);
+    int n = 0;
+    for (size_t e = 0; e < m.size(); ++e) n += m[e] != s.field.period_jump[e];
+    return n;
+  };
+  EXPECT_EQ(steep(a), 0);
+  EXPECT_EQ(steep(b), 0);
+  for (int n = 0; n < b.topology.num_nodes; ++n)
+    EXPECT_EQ(b.indices[in.layout.nodes[n].vertex], 4 - b.topology.valence[n]);
 }
 
 TEST(CrossField, RealGenus2LayoutFromQuadWild) {

@@ -1,9 +1,9 @@
 #include "core/field/cross_field.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <deque>
 
 #include "core/base/errors.h"
 
@@ -27,7 +27,8 @@ CrossFieldSolver::CrossFieldSolver(const TriMesh& mesh, const GeometryCache& g,
                                    const Layout& layout, const LayoutTopology& topology,
                                    const CrossFieldOptions& options)
     : options_(options) {
-  auto t0 = std::chrono::steady_clock::now();
+  const auto t_setup = std::chrono::steady_clock::now();
+  auto t0 = t_setup;
   Curvature curvature;
   if (options.constraints.curvature)
     curvature = compute_curvature(mesh, g, options.constraints.curvature_options);
@@ -44,64 +45,27 @@ CrossFieldSolver::CrossFieldSolver(const TriMesh& mesh, const GeometryCache& g,
   const int nc = static_cast<int>(field_.constraints.face.size());
   constraint_dir_ = field_.constraints.direction;
 
-  // Clusters: BFS over constrained faces and the faces touching boundary/feature curves (the
-  // "ring" that carries the angle between alternating constrained faces, algorithm.md §3.2).
-  std::vector<int> constraint_at(nf, -1);
-  for (int k = 0; k < nc; ++k) constraint_at[field_.constraints.face[k]] = k;
-  std::vector<char> carrier(nf, 0);
+  // Clusters: constrained faces connected through the constrained faces and the faces touching
+  // boundary/feature curves (the "ring" that carries the angle between alternating constrained
+  // faces, algorithm.md §3.2).
+  constraint_at_.assign(nf, -1);
+  for (int k = 0; k < nc; ++k) constraint_at_[field_.constraints.face[k]] = k;
+  carrier_.assign(nf, 0);
   for (int k = 0; k < nc; ++k) {
     const int f = field_.constraints.face[k];
-    carrier[f] = 1;
+    carrier_[f] = 1;
     if (field_.constraints.kind[k] == ConstraintKind::Curvature) continue;
-    for (auto v : mesh.fv_range(mesh.face_handle(f)))
-      for (auto f2 : mesh.vf_range(v)) carrier[f2.idx()] = 1;
+    for (int v : g.face_vertices[f])
+      for (auto f2 : mesh.vf_range(mesh.vertex_handle(v))) carrier_[f2.idx()] = 1;
   }
-  std::vector<double> c(nc);
-  for (int k = 0; k < nc; ++k)
-    c[k] = g.angle_in_face(field_.constraints.face[k], constraint_dir_[k]);
-  cluster_of_.assign(nc, -1);
-  relative_q_.assign(nc, 0);
-  std::vector<double> carried(nf, 0.0);
-  std::vector<char> visited(nf, 0);
-  std::vector<int> cluster_size;
-  for (int k0 = 0; k0 < nc; ++k0) {
-    const int f0 = field_.constraints.face[k0];
-    if (visited[f0]) continue;
-    const int cl = static_cast<int>(cluster_size.size());
-    cluster_size.push_back(0);
-    visited[f0] = 1;
-    carried[f0] = c[k0];
-    std::deque<int> queue{f0};
-    while (!queue.empty()) {
-      const int f = queue.front();
-      queue.pop_front();
-      const int k = constraint_at[f];
-      if (k >= 0) {
-        relative_q_[k] = static_cast<int>(std::lround((carried[f] - c[k]) / kQuarter));
-        carried[f] = c[k] + kQuarter * relative_q_[k];
-        cluster_of_[k] = cl;
-        ++cluster_size[cl];
-      }
-      for (auto h : mesh.fh_range(mesh.face_handle(f))) {
-        const auto opp = mesh.opposite_halfedge_handle(h);
-        if (mesh.is_boundary(opp)) continue;
-        const int f2 = mesh.face_handle(opp).idx();
-        if (visited[f2] || !carrier[f2]) continue;
-        const int e = mesh.edge_handle(h).idx();
-        const double step = g.kappa[e] + kQuarter * field_.period_jump[e];
-        carried[f2] = (g.edge_face_i[e] == f) ? carried[f] + step : carried[f] - step;
-        visited[f2] = 1;
-        queue.push_back(f2);
-      }
-    }
-  }
-  field_.clusters = static_cast<int>(cluster_size.size());
+  propagate_clusters(mesh, g);
   cluster_offset_.assign(field_.clusters, 0);
   cluster_active_.assign(field_.clusters, 1);
+  constraint_active_.assign(nc, 1);
 
   // Matrix: dual-graph Laplacian + λ on constrained faces (+ a gauge face if unconstrained).
   std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(4 * g.n_edges + nc + 1);
+  triplets.reserve(3 * g.n_edges + nc + 1);
   for (int e = 0; e < g.n_edges; ++e) {
     if (!interior(g, e)) continue;
     const int i = g.edge_face_i[e], j = g.edge_face_j[e];
@@ -125,65 +89,196 @@ CrossFieldSolver::CrossFieldSolver(const TriMesh& mesh, const GeometryCache& g,
                                         : mesh.face_handle(h);
     field_.gauge_face = fh.idx();
     triplets.emplace_back(field_.gauge_face, field_.gauge_face, lambda);
-    gauge_angle_.resize(1);
-    gauge_angle_(0) =
-        g.angle_in_face(field_.gauge_face, mesh.point(mesh.vertex_handle(path[m + 1])) -
-                                               mesh.point(mesh.vertex_handle(path[m])));
+    gauge_angle_ = g.angle_in_face(field_.gauge_face, mesh.point(mesh.vertex_handle(path[m + 1])) -
+                                                          mesh.point(mesh.vertex_handle(path[m])));
   }
-  Eigen::SparseMatrix<double> L(nf, nf);
-  L.setFromTriplets(triplets.begin(), triplets.end());
+  matrix_.resize(nf, nf);
+  matrix_.setFromTriplets(triplets.begin(), triplets.end());
   field_.timings.assemble_s = seconds_since(t0);
-  t0 = std::chrono::steady_clock::now();
-  if (field_.clusters > 1) {
-    // Warm start for the cluster rotations: the smoothest field held only by the largest
-    // cluster (same pattern, so the symbolic analysis is shared), then round every other
-    // cluster against it (algorithm.md §3.2).
-    const int largest = static_cast<int>(
-        std::max_element(cluster_size.begin(), cluster_size.end()) - cluster_size.begin());
-    Eigen::SparseMatrix<double> L0 = L;
-    for (int k = 0; k < nc; ++k)
-      if (cluster_of_[k] != largest)
-        L0.coeffRef(field_.constraints.face[k], field_.constraints.face[k]) -= lambda;
-    solver_.factorize(L0);
-    Eigen::VectorXd b = rhs(g, c);
-    // rhs() added λ·target for every constraint; only the largest cluster's stay.
-    for (int k = 0; k < nc; ++k) {
-      if (cluster_of_[k] == largest) continue;
-      const int q = relative_q_[k] + cluster_offset_[cluster_of_[k]];
-      b(field_.constraints.face[k]) -= lambda * (c[k] + kQuarter * q);
-    }
-    const Eigen::VectorXd theta0 = solver_.solve(b);
-    round_clusters(g, c, theta0);
-  }
-  solver_.factorize(L);
+
+  // The only factorization needed when no cluster contradicts the layout.
+  factorize(solver_, matrix_);
+  warm_start(g, /*allow_factorization=*/true);
   solve(g);
-  // Drop constraint clusters that contradict the layout's topology, then re-solve.
-  int rings = options.conflict_rings;
+  drop_conflicting_clusters(mesh, g);
+  field_.active_constraints = nc - field_.dropped_constraints;
+  field_.timings.setup_s = seconds_since(t_setup);
+}
+
+CrossFieldSolver::~CrossFieldSolver() = default;
+
+void CrossFieldSolver::factorize(SpdSolver& solver, const Eigen::SparseMatrix<double>& A) {
+  const auto t0 = std::chrono::steady_clock::now();
+  solver.factorize(A);
+  field_.timings.factorize_s += seconds_since(t0);
+  ++field_.timings.factorizations;
+}
+
+Eigen::VectorXd CrossFieldSolver::back_substitute(const Eigen::VectorXd& b) {
+  ++field_.timings.solves;
+  return solver_.solve(b);
+}
+
+void CrossFieldSolver::propagate_clusters(const TriMesh& mesh, const GeometryCache& g) {
+  const int nf = g.n_faces;
+  const int nc = static_cast<int>(field_.constraints.face.size());
+  const std::vector<double> c = constraint_angles(g);
+  cluster_of_.assign(nc, -1);
+  relative_q_.assign(nc, 0);
+  cluster_size_.clear();
+  std::vector<double> carried(nf, 0.0);
+  std::vector<char> visited(nf, 0);
+  std::vector<int> queue;
+  queue.reserve(nf);
+  for (int k0 = 0; k0 < nc; ++k0) {
+    const int f0 = field_.constraints.face[k0];
+    if (visited[f0]) continue;
+    const int cl = static_cast<int>(cluster_size_.size());
+    cluster_size_.push_back(0);
+    visited[f0] = 1;
+    carried[f0] = c[k0];
+    queue.assign(1, f0);
+    for (size_t head = 0; head < queue.size(); ++head) {
+      const int f = queue[head];
+      const int k = constraint_at_[f];
+      if (k >= 0) {
+        relative_q_[k] = static_cast<int>(std::lround((carried[f] - c[k]) / kQuarter));
+        carried[f] = c[k] + kQuarter * relative_q_[k];
+        cluster_of_[k] = cl;
+        ++cluster_size_[cl];
+      }
+      for (auto h : mesh.fh_range(mesh.face_handle(f))) {
+        const auto opp = mesh.opposite_halfedge_handle(h);
+        if (mesh.is_boundary(opp)) continue;
+        const int f2 = mesh.face_handle(opp).idx();
+        if (visited[f2] || !carrier_[f2]) continue;
+        const int e = mesh.edge_handle(h).idx();
+        const double step = g.kappa[e] + kQuarter * field_.period_jump[e];
+        carried[f2] = (g.edge_face_i[e] == f) ? carried[f] + step : carried[f] - step;
+        visited[f2] = 1;
+        queue.push_back(f2);
+      }
+    }
+  }
+  field_.clusters = static_cast<int>(cluster_size_.size());
+}
+
+void CrossFieldSolver::warm_start(const GeometryCache& g, bool allow_factorization) {
+  if (field_.clusters <= 1) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  const double factorize_before = field_.timings.factorize_s;
+  const int nc = static_cast<int>(field_.constraints.face.size());
+  const double lambda = options_.constraint_weight;
+  const std::vector<double> c = constraint_angles(g);
+  int largest = -1;
+  for (int cl = 0; cl < field_.clusters; ++cl)
+    if (cluster_active_[cl] && (largest < 0 || cluster_size_[cl] > cluster_size_[largest]))
+      largest = cl;
+  if (largest < 0) return;
+  std::vector<int> others;  // active clusters whose rotation is relaxed
+  std::vector<int> column(field_.clusters, -1);
+  for (int cl = 0; cl < field_.clusters; ++cl)
+    if (cl != largest && cluster_active_[cl]) {
+      column[cl] = static_cast<int>(others.size());
+      others.push_back(cl);
+    }
+  // The relaxed system needs one dense right-hand side per relaxed cluster (#F doubles each):
+  // bounded by the cluster count and by 8M entries (64 MB).
+  const bool relaxed = options_.warm_start == ClusterWarmStart::Relaxed &&
+                       static_cast<int>(others.size()) <= options_.max_relaxed_clusters &&
+                       static_cast<double>(others.size()) * g.n_faces <= 8e6;
+  if (!relaxed && !allow_factorization) return;
+  std::fill(cluster_offset_.begin(), cluster_offset_.end(), 0);
+  if (others.empty()) return;
+  Eigen::VectorXd theta;
+  if (relaxed) {
+    // E(θ, o) = θᵀLθ − 2θᵀ(b₀ + S o) + Σ_f λ(t_f + (π/2)o_cl(f))², with t_f = c_f + (π/2)q_f
+    // and S = λ(π/2)·(cluster indicators). θ(o) = θ₀ + Y o with Y = L⁻¹S, and the reduced
+    // system is (λ(π/2)²·diag(n) − SᵀY) o = Sᵀθ₀ − λ(π/2)·Σ_cluster t_f.
+    const int m = static_cast<int>(others.size());
+    const Eigen::VectorXd theta0 = back_substitute(rhs(g, c));
+    Eigen::MatrixXd S = Eigen::MatrixXd::Zero(g.n_faces, m);
+    Eigen::VectorXd r = Eigen::VectorXd::Zero(m);
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(m, m);
+    for (int k = 0; k < nc; ++k) {
+      const int j = column[cluster_of_[k]];
+      if (j < 0 || !active(k)) continue;
+      const int f = field_.constraints.face[k];
+      S(f, j) = lambda * kQuarter;
+      r(j) += lambda * kQuarter * (theta0(f) - (c[k] + kQuarter * relative_q_[k]));
+      M(j, j) += lambda * kQuarter * kQuarter;
+    }
+    ++field_.timings.solves;
+    const Eigen::MatrixXd Y = solver_.solve(S);
+    M.noalias() -= S.transpose() * Y;
+    const Eigen::VectorXd o = M.ldlt().solve(r);
+    theta = theta0 + Y * o;
+  } else {
+    // The smoothest field held only by the largest cluster (same pattern: the spare solver's
+    // analysis is reused later by the conflict trials).
+    Eigen::SparseMatrix<double> L0 = matrix_;
+    Eigen::VectorXd b = rhs(g, c);
+    for (int k = 0; k < nc; ++k) {
+      if (cluster_of_[k] == largest || !active(k)) continue;
+      const int f = field_.constraints.face[k];
+      L0.coeffRef(f, f) -= lambda;
+      b(f) -= lambda * (c[k] + kQuarter * relative_q_[k]);
+    }
+    factorize(spare_, L0);
+    ++field_.timings.solves;
+    theta = spare_.solve(b);
+  }
+  round_clusters(c, theta);
+  field_.timings.warm_start_s +=
+      seconds_since(t0) - (field_.timings.factorize_s - factorize_before);
+}
+
+void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const GeometryCache& g) {
+  const int nf = g.n_faces;
+  const int nc = static_cast<int>(field_.constraints.face.size());
+  if (nc == 0 || options_.max_conflict_passes <= 0) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  const double factorize_before = field_.timings.factorize_s;
+  const double lambda = options_.constraint_weight;
+  int rings = options_.conflict_rings;
   auto count_mismatches = [&] {
-    const std::vector<int> m = principal_matching(g, field_.theta);
     int bad = 0;
-    for (int e = 0; e < g.n_edges; ++e) bad += interior(g, e) && m[e] != field_.period_jump[e];
+    for (int e = 0; e < g.n_edges; ++e) {
+      if (!interior(g, e)) continue;
+      const double d = field_.theta[g.edge_face_j[e]] - field_.theta[g.edge_face_i[e]] - g.kappa[e];
+      bad += std::lround(d / kQuarter) != field_.period_jump[e];
+    }
     return bad;
   };
   int mismatches = count_mismatches();
-  for (int pass = 0; pass < options.max_conflict_passes && nc > 0 && mismatches > 0; ++pass) {
+  std::vector<int> dist(nf), queue;
+  std::vector<char> in_drop(field_.clusters, 0);
+  for (int pass = 0; pass < options_.max_conflict_passes && mismatches > 0; ++pass) {
+    // Clusters within `rings` face rings of an edge the field steps over by more than 45°.
     const std::vector<int> matching = principal_matching(g, field_.theta);
-    std::vector<int> dist(nf, -1);
-    std::deque<int> queue;
+    std::fill(dist.begin(), dist.end(), -1);
+    queue.clear();
     for (int e = 0; e < g.n_edges; ++e) {
       if (!interior(g, e) || matching[e] == field_.period_jump[e]) continue;
       for (int f : {g.edge_face_i[e], g.edge_face_j[e]})
         if (dist[f] < 0) dist[f] = 0, queue.push_back(f);
     }
     if (queue.empty()) break;
-    std::vector<int> drop;
-    while (!queue.empty()) {
-      const int f = queue.front();
-      queue.pop_front();
-      const int k = constraint_at[f];
-      if (k >= 0 && cluster_active_[cluster_of_[k]] &&
-          std::find(drop.begin(), drop.end(), cluster_of_[k]) == drop.end())
-        drop.push_back(cluster_of_[k]);
+    // Constraints whose λ is removed in this trial: whole clusters, or (Faces mode) only the
+    // constrained faces near the steep edges.
+    const bool by_faces = options_.conflict_drop == ConflictDrop::Faces;
+    std::vector<int> drop, removed;
+    for (size_t head = 0; head < queue.size(); ++head) {
+      const int f = queue[head];
+      const int k = constraint_at_[f];
+      if (k >= 0 && active(k)) {
+        if (by_faces) {
+          removed.push_back(k);
+        } else if (!in_drop[cluster_of_[k]]) {
+          in_drop[cluster_of_[k]] = 1;
+          drop.push_back(cluster_of_[k]);
+        }
+      }
       if (dist[f] >= rings) continue;
       for (auto h : mesh.fh_range(mesh.face_handle(f))) {
         const auto opp = mesh.opposite_halfedge_handle(h);
@@ -192,59 +287,83 @@ CrossFieldSolver::CrossFieldSolver(const TriMesh& mesh, const GeometryCache& g,
         if (dist[f2] < 0) dist[f2] = dist[f] + 1, queue.push_back(f2);
       }
     }
-    if (drop.empty()) {
-      // The conflicting clusters are farther away: widen the search (bounded).
-      if (rings >= 64 * options.conflict_rings) break;
+    if (drop.empty() && removed.empty()) {
+      // The conflicting constraints are farther away: widen the search (bounded).
+      if (rings >= 64 * options_.conflict_rings) break;
       rings *= 4;
       --pass;
       continue;
     }
-    for (int cl : drop) {
-      cluster_active_[cl] = 0;
-      ++field_.dropped_clusters;
+    // Trial: factorize without the removed constraints in the spare solver; the current
+    // factorization stays available if the trial is rejected.
+    for (int k = 0; k < nc; ++k)
+      if (in_drop[cluster_of_[k]] && active(k)) removed.push_back(k);
+    for (int cl : drop) cluster_active_[cl] = 0;
+    for (int k : removed) {
+      if (by_faces) constraint_active_[k] = 0;
+      const int f = field_.constraints.face[k];
+      matrix_.coeffRef(f, f) -= lambda;
     }
-    for (int k = 0; k < nc; ++k) {
-      if (cluster_active_[cluster_of_[k]] ||
-          std::find(drop.begin(), drop.end(), cluster_of_[k]) == drop.end())
-        continue;
-      L.coeffRef(field_.constraints.face[k], field_.constraints.face[k]) -= lambda;
-      ++field_.dropped_constraints;
-    }
-    if (std::find(cluster_active_.begin(), cluster_active_.end(), 1) == cluster_active_.end() &&
-        field_.gauge_face < 0) {
+    field_.dropped_constraints += static_cast<int>(removed.size());
+    const int gauge_before = field_.gauge_face;
+    const double gauge_angle_before = gauge_angle_;
+    bool any_left = false;
+    for (int k = 0; k < nc && !any_left; ++k) any_left = active(k);
+    if (!any_left && field_.gauge_face < 0) {
       // Nothing left to fix the global rotation on a closed surface: pin one face (it is
       // re-chosen to minimize the energy by the parameterization stage).
       field_.gauge_face = field_.constraints.face[0];
-      gauge_angle_.resize(1);
-      gauge_angle_(0) = field_.theta[field_.gauge_face];
-      L.coeffRef(field_.gauge_face, field_.gauge_face) += lambda;
+      gauge_angle_ = field_.theta[field_.gauge_face];
+      matrix_.coeffRef(field_.gauge_face, field_.gauge_face) += lambda;
     }
-    solver_.factorize(L);
+    factorize(spare_, matrix_);
+    std::swap(solver_, spare_);
     solve(g);
+    ++field_.timings.conflict_passes;
     const int now = count_mismatches();
     if (now >= mismatches) {
       // Dropping did not help: these steps are not caused by constraints (e.g. the smoothest
-      // field itself turns by more than 45° across an edge). Restore the clusters and stop.
-      for (int cl : drop) {
-        cluster_active_[cl] = 1;
-        --field_.dropped_clusters;
+      // field itself turns by more than 45° across an edge). Restore the constraints, go back
+      // to the previous factorization (kept in the spare solver) and stop.
+      std::swap(solver_, spare_);
+      for (int cl : drop) cluster_active_[cl] = 1;
+      for (int k : removed) {
+        constraint_active_[k] = 1;
+        const int f = field_.constraints.face[k];
+        matrix_.coeffRef(f, f) += lambda;
       }
-      for (int k = 0; k < nc; ++k) {
-        if (std::find(drop.begin(), drop.end(), cluster_of_[k]) == drop.end()) continue;
-        L.coeffRef(field_.constraints.face[k], field_.constraints.face[k]) += lambda;
-        --field_.dropped_constraints;
+      field_.dropped_constraints -= static_cast<int>(removed.size());
+      if (field_.gauge_face != gauge_before) {
+        matrix_.coeffRef(field_.gauge_face, field_.gauge_face) -= lambda;
+        field_.gauge_face = gauge_before;
+        gauge_angle_ = gauge_angle_before;
       }
-      solver_.factorize(L);
+      for (int cl : drop) in_drop[cl] = 0;
       solve(g);
       break;
     }
+    for (int cl : drop) in_drop[cl] = 0;
     mismatches = now;
   }
-  field_.active_constraints = nc - field_.dropped_constraints;
-  field_.timings.factorize_s = seconds_since(t0);
+  // A cluster counts as dropped when none of its constraints is in force any more.
+  std::vector<char> any_active(field_.clusters, 0);
+  for (int k = 0; k < nc; ++k)
+    if (active(k)) any_active[cluster_of_[k]] = 1;
+  field_.dropped_clusters = 0;
+  for (int cl = 0; cl < field_.clusters; ++cl) {
+    cluster_active_[cl] = any_active[cl];
+    field_.dropped_clusters += !any_active[cl];
+  }
+  field_.timings.conflicts_s += seconds_since(t0) - (field_.timings.factorize_s - factorize_before);
 }
 
-CrossFieldSolver::~CrossFieldSolver() = default;
+std::vector<double> CrossFieldSolver::constraint_angles(const GeometryCache& g) const {
+  const int nc = static_cast<int>(field_.constraints.face.size());
+  std::vector<double> c(nc);
+  for (int k = 0; k < nc; ++k)
+    c[k] = g.angle_in_face(field_.constraints.face[k], constraint_dir_[k]);
+  return c;
+}
 
 Eigen::VectorXd CrossFieldSolver::rhs(const GeometryCache& g, const std::vector<double>& c) const {
   Eigen::VectorXd b = Eigen::VectorXd::Zero(g.n_faces);
@@ -256,24 +375,22 @@ Eigen::VectorXd CrossFieldSolver::rhs(const GeometryCache& g, const std::vector<
   }
   const double lambda = options_.constraint_weight;
   for (size_t k = 0; k < c.size(); ++k) {
-    if (!cluster_active_[cluster_of_[k]]) continue;
+    if (!active(k)) continue;
     const int q = relative_q_[k] + cluster_offset_[cluster_of_[k]];
     b(field_.constraints.face[k]) += lambda * (c[k] + kQuarter * q);
   }
-  if (field_.gauge_face >= 0) b(field_.gauge_face) += lambda * gauge_angle_(0);
+  if (field_.gauge_face >= 0) b(field_.gauge_face) += lambda * gauge_angle_;
   return b;
 }
 
-void CrossFieldSolver::round_clusters(const GeometryCache& g, const std::vector<double>& c,
-                                      const Eigen::VectorXd& theta) {
-  (void)g;
+void CrossFieldSolver::round_clusters(const std::vector<double>& c, const Eigen::VectorXd& theta) {
   std::vector<double> sum(field_.clusters, 0.0), weight(field_.clusters, 0.0);
   for (size_t k = 0; k < c.size(); ++k) {
+    if (!constraint_active_[k]) continue;  // released faces (a dropped cluster still rounds)
     const int f = field_.constraints.face[k];
     const int cl = cluster_of_[k];
     // Offset of the cluster rotation that best matches θ here, in quarter turns.
-    double d = (theta(f) - c[k]) / kQuarter - relative_q_[k];
-    sum[cl] += d;
+    sum[cl] += (theta(f) - c[k]) / kQuarter - relative_q_[k];
     weight[cl] += 1;
   }
   for (int cl = 0; cl < field_.clusters; ++cl)
@@ -282,34 +399,50 @@ void CrossFieldSolver::round_clusters(const GeometryCache& g, const std::vector<
 
 const CrossField& CrossFieldSolver::solve(const GeometryCache& g) {
   const auto t0 = std::chrono::steady_clock::now();
+  if (g.n_faces != matrix_.rows())
+    throw InvalidInputError("cross field: the geometry has " + std::to_string(g.n_faces) +
+                            " faces, the solver was built for " + std::to_string(matrix_.rows()));
   const int nc = static_cast<int>(field_.constraints.face.size());
-  std::vector<double> c(nc);
-  for (int k = 0; k < nc; ++k)
-    c[k] = g.angle_in_face(field_.constraints.face[k], constraint_dir_[k]);
-  Eigen::VectorXd theta;
-  if (nc == 0) {
-    theta = solver_.solve(rhs(g, c));
-  } else {
-    theta = solver_.solve(rhs(g, c));
-    for (int pass = 0; pass < options_.max_rounding_passes; ++pass) {
-      const std::vector<int> before = cluster_offset_;
-      round_clusters(g, c, theta);
-      if (before == cluster_offset_) break;
-      theta = solver_.solve(rhs(g, c));
-    }
+  const std::vector<double> c = constraint_angles(g);
+  Eigen::VectorXd theta = back_substitute(rhs(g, c));
+  field_.timings.rounding_passes = 0;
+  for (int pass = 0; nc > 0 && pass < options_.max_rounding_passes; ++pass) {
+    const std::vector<int> before = cluster_offset_;
+    round_clusters(c, theta);
+    if (before == cluster_offset_) break;
+    theta = back_substitute(rhs(g, c));
+    ++field_.timings.rounding_passes;
   }
-  solved_once_ = true;
   field_.theta.assign(theta.data(), theta.data() + theta.size());
   field_.constraint_q.resize(nc);
   for (int k = 0; k < nc; ++k)
     field_.constraint_q[k] = relative_q_[k] + cluster_offset_[cluster_of_[k]];
+  field_.constraint_active.resize(nc);
+  for (int k = 0; k < nc; ++k) field_.constraint_active[k] = active(k) ? 1 : 0;
   field_.timings.solve_s = seconds_since(t0);
   return field_;
 }
 
+const CrossField& CrossFieldSolver::update_layout(const TriMesh& mesh, const GeometryCache& g,
+                                                  const Layout& layout,
+                                                  const LayoutTopology& topology) {
+  if (g.n_faces != matrix_.rows() || static_cast<int>(mesh.n_faces()) != g.n_faces)
+    throw InvalidInputError("cross field: the mesh changed size since the solver was built");
+  auto t0 = std::chrono::steady_clock::now();
+  field_.period_jump = compute_period_jumps(mesh, g, layout, topology, &field_.topology);
+  field_.timings.period_jumps_s = seconds_since(t0);
+  // Cluster membership depends on the constraint set only; the relative rotations on p.
+  const std::vector<int> old_cluster = cluster_of_;
+  propagate_clusters(mesh, g);
+  if (cluster_of_ != old_cluster)
+    throw QsError("internal error: constraint clusters changed in update_layout");
+  warm_start(g, /*allow_factorization=*/false);
+  return solve(g);
+}
+
 void CrossFieldSolver::rotate(double phi) {
   for (double& t : field_.theta) t += phi;
-  if (field_.gauge_face >= 0) gauge_angle_(0) += phi;
+  if (field_.gauge_face >= 0) gauge_angle_ += phi;
 }
 
 CrossField compute_cross_field(const TriMesh& mesh, const GeometryCache& geometry,

@@ -13,20 +13,54 @@
 
 namespace qs {
 
+//! How the integer rotations of the constraint clusters are initialized (algorithm.md §3.2).
+enum class ClusterWarmStart {
+  //! Relax every cluster rotation to a real number, minimize the energy jointly with θ (the
+  //! factorized field matrix plus one multi-right-hand-side solve, no extra factorization),
+  //! then round each (MIQ-style relax-and-round).
+  Relaxed,
+  //! The smoothest field held only by the largest cluster (one extra factorization), every
+  //! other cluster rounded against it. Used when there are more than `max_relaxed_clusters`.
+  LargestCluster,
+};
+
+//! What is released when the field contradicts the layout near an edge (see CrossFieldOptions).
+enum class ConflictDrop {
+  Clusters,  //!< every constraint cluster with a constrained face near a steep edge
+  Faces,     //!< only the constrained faces near steep edges (experimental)
+};
+
 struct CrossFieldOptions {
   double constraint_weight = 100.0;  //!< λ, the paper's penalty factor
   ConstraintOptions constraints;
   int max_rounding_passes = 5;  //!< re-rounding of cluster rotations after each solve
+  ClusterWarmStart warm_start = ClusterWarmStart::Relaxed;
+  //! Above this many clusters (or 8M right-hand-side entries, #F per cluster) the relaxed warm
+  //! start (one solve per cluster) falls back to LargestCluster.
+  int max_relaxed_clusters = 64;
   //! Constraint clusters that contradict the layout's topology (the solved field then jumps by
   //! more than 45° across some edge, i.e. its principal matching differs from the prescribed
   //! period jumps) are dropped: the nearest clusters within `conflict_rings` face rings of each
   //! such edge, for at most `max_conflict_passes` re-solves.
   int max_conflict_passes = 6;
   int conflict_rings = 6;
+  ConflictDrop conflict_drop = ConflictDrop::Clusters;
 };
 
+//! Wall-clock seconds of the field stage's parts and operation counts (see bench/field_bench).
 struct CrossFieldTimings {
-  double curvature_s = 0, period_jumps_s = 0, assemble_s = 0, factorize_s = 0, solve_s = 0;
+  double curvature_s = 0;     //!< curvature tensor, reliable set and constraint collection
+  double period_jumps_s = 0;  //!< exact integer period jumps from the layout
+  double assemble_s = 0;      //!< constraint clusters and matrix assembly
+  double factorize_s = 0;     //!< every CHOLMOD analysis + factorization of the setup
+  double warm_start_s = 0;    //!< warm-start solve and cluster rounding (no factorization)
+  double conflicts_s = 0;     //!< conflict checks and re-solves (no factorization)
+  double solve_s = 0;         //!< last call of solve(): right-hand side, solves, rounding
+  double setup_s = 0;         //!< whole constructor
+  int factorizations = 0;     //!< numeric factorizations in the setup
+  int solves = 0;             //!< back-substitutions (setup and re-solves)
+  int rounding_passes = 0;    //!< extra solves after re-rounding cluster rotations (last solve)
+  int conflict_passes = 0;    //!< re-solves after dropping contradicting clusters
 };
 
 struct CrossField {
@@ -34,18 +68,21 @@ struct CrossField {
   std::vector<int> period_jump;   //!< per edge (canonical dual orientation), size #E
   FieldConstraints constraints;   //!< the direction constraints used
   std::vector<int> constraint_q;  //!< per constraint: integer quarter-turn offset
-  int clusters = 0;               //!< constraint clusters (each with one free rotation)
-  int gauge_face = -1;            //!< face pinned when there are no constraints
-  int dropped_clusters = 0;       //!< clusters dropped because they contradict the topology
-  int dropped_constraints = 0;    //!< constrained faces in those clusters
-  int active_constraints = 0;     //!< constrained faces still in force
+  //! Per constraint: 1 when in force, 0 when dropped as contradicting the layout's topology.
+  std::vector<char> constraint_active;
+  int clusters = 0;             //!< constraint clusters (each with one free rotation)
+  int gauge_face = -1;          //!< face pinned when there are no constraints
+  int dropped_clusters = 0;     //!< clusters dropped because they contradict the topology
+  int dropped_constraints = 0;  //!< constrained faces in those clusters
+  int active_constraints = 0;   //!< constrained faces still in force
   PeriodJumpReport topology;
   CrossFieldTimings timings;
 };
 
-//! Stateful solver: builds constraints, period jumps and the factorized matrix once; `solve`
-//! can be called again after the geometry changed (κ, constraint angles), reusing the
-//! factorization.
+//! Stateful solver: builds constraints, period jumps and the factorized matrix once. The
+//! matrix depends on neither the geometry nor the period jumps, only on the set of active
+//! constraints: `solve` after vertices moved and `update_layout` after nodes moved to other
+//! vertices (new period jumps) only back-substitute with the existing factorization.
 class CrossFieldSolver {
  public:
   //! \throw TopologyError for layouts whose topology cannot be realized, SolverError.
@@ -53,28 +90,56 @@ class CrossFieldSolver {
                    const LayoutTopology& topology, const CrossFieldOptions& options = {});
   ~CrossFieldSolver();
 
-  //! Solves for θ with the current geometry (reuses the factorization).
+  //! Solves for θ with the current geometry (reuses the factorization). \p geometry must be the
+  //! construction's cache continued by update_geometry (same connectivity, κ continued), so that
+  //! the period jumps stay valid. The constraint directions are the original 3D directions,
+  //! projected onto the current faces.
   const CrossField& solve(const GeometryCache& geometry);
+  //! After the layout changed on the same mesh connectivity (nodes moved to other vertices,
+  //! arcs rerouted): recomputes the period jumps and the clusters' relative rotations, redoes
+  //! the warm start (relaxed mode) and re-solves, reusing the factorization. The constraint set
+  //! (and clusters dropped as contradictory, and the gauge face) are kept from construction.
+  //! \throw TopologyError as the constructor, InvalidInputError when the mesh size changed.
+  const CrossField& update_layout(const TriMesh& mesh, const GeometryCache& geometry,
+                                  const Layout& layout, const LayoutTopology& topology);
   const CrossField& field() const { return field_; }
   //! Rotates the whole field by φ (radians) — meaningful only when it has no direction
   //! constraints (its global rotation is then free); later re-solves keep the rotation.
   void rotate(double phi);
+  //! The field matrix currently factorized (dual-graph Laplacian + λ on active constraints).
+  const Eigen::SparseMatrix<double>& matrix() const { return matrix_; }
 
  private:
   Eigen::VectorXd rhs(const GeometryCache& geometry, const std::vector<double>& c) const;
-  void round_clusters(const GeometryCache& geometry, const std::vector<double>& c,
-                      const Eigen::VectorXd& theta);
+  std::vector<double> constraint_angles(const GeometryCache& geometry) const;
+  void factorize(SpdSolver& solver, const Eigen::SparseMatrix<double>& A);  //!< timed, counted
+  Eigen::VectorXd back_substitute(const Eigen::VectorXd& b);
+  //! Relative rotations inside each cluster by propagation over the carrier faces (needs p).
+  void propagate_clusters(const TriMesh& mesh, const GeometryCache& geometry);
+  //! Initial cluster offsets (see ClusterWarmStart); solver_ holds the factorization of matrix_.
+  //! Without \p allow_factorization only the relaxed warm start runs (else offsets are kept).
+  void warm_start(const GeometryCache& geometry, bool allow_factorization);
+  void round_clusters(const std::vector<double>& c, const Eigen::VectorXd& theta);
+  void drop_conflicting_clusters(const TriMesh& mesh, const GeometryCache& geometry);
 
   CrossFieldOptions options_;
   CrossField field_;
-  std::vector<int> cluster_of_;       //!< per constraint
-  std::vector<int> relative_q_;       //!< per constraint, within its cluster
-  std::vector<int> cluster_offset_;   //!< per cluster
-  std::vector<char> cluster_active_;  //!< per cluster: 0 once dropped as contradictory
+  std::vector<int> constraint_at_;       //!< per face: constraint index or -1
+  std::vector<char> carrier_;            //!< per face: carries the angle between constraints
+  std::vector<int> cluster_size_;        //!< per cluster: constrained faces
+  std::vector<int> cluster_of_;          //!< per constraint
+  std::vector<int> relative_q_;          //!< per constraint, within its cluster
+  std::vector<int> cluster_offset_;      //!< per cluster
+  std::vector<char> cluster_active_;     //!< per cluster: 0 once dropped as contradictory
+  std::vector<char> constraint_active_;  //!< per constraint: 0 once dropped
+  bool active(int k) const { return cluster_active_[cluster_of_[k]] && constraint_active_[k]; }
   std::vector<Vec3> constraint_dir_;  //!< original 3D directions
-  Eigen::VectorXd gauge_angle_;
+  double gauge_angle_ = 0;
+  Eigen::SparseMatrix<double> matrix_;
   SpdSolver solver_{"cross field"};
-  bool solved_once_ = false;
+  //! Second factorization of the same pattern (trial drops, largest-cluster warm start), so a
+  //! rejected trial never needs a re-factorization; symbolic analysis reused between trials.
+  SpdSolver spare_{"cross field"};
 };
 
 //! Convenience: geometry + topology + one solve.

@@ -50,10 +50,21 @@ std::string arc_list(const Layout& layout, const std::vector<std::pair<int, bool
   return ss.str();
 }
 
-// Affine integer function c + Σ coef_k g_k.
-struct Affine {
-  long c = 0;
-  std::vector<long> coef;
+// Affine integer functions c + Σ_k coef_k g_k of the free unknowns g, one per row, stored flat
+// (row r's coefficients at coef[r·n, (r+1)·n)): no allocation per edge or vertex.
+struct AffineRows {
+  int n = 0;  // free unknowns
+  std::vector<long> c, coef;
+  AffineRows(size_t rows, int nfree) : n(nfree), c(rows, 0), coef(rows * nfree, 0) {}
+  long* row(size_t r) { return coef.data() + r * n; }
+  const long* row(size_t r) const { return coef.data() + r * n; }
+  //! this[r] += s · other[q]
+  void add(size_t r, long s, const AffineRows& other, size_t q) {
+    c[r] += s * other.c[q];
+    long* a = row(r);
+    const long* b = other.row(q);
+    for (int k = 0; k < n; ++k) a[k] += s * b[k];
+  }
 };
 
 }  // namespace
@@ -151,24 +162,79 @@ struct CycleEquation {
   bool ok = false;
 };
 
+// The left face strip Γ of a path at its vertex w, entered by u→w and left by w→y: calls
+// term(edge, sign) for every edge {w,z} crossed clockwise around w from the face holding u→w
+// to the face holding w→y, and adds that edge's signed κ and π − β_w (β_w: the visited corner
+// angles at w) to the sums. False when the strip runs through the exterior.
+template <class Term>
+bool left_strip_at(const TriMesh& mesh, const GeometryCache& g, int u_idx, int w_idx, int y_idx,
+                   double& kappa_sum, double& angle_term, Term&& term) {
+  const auto u = mesh.vertex_handle(u_idx);
+  const auto w = mesh.vertex_handle(w_idx);
+  const auto y = mesh.vertex_handle(y_idx);
+  const auto h_in = mesh.find_halfedge(u, w);
+  const auto h_out = mesh.find_halfedge(w, y);
+  if (mesh.is_boundary(h_in) || mesh.is_boundary(h_out)) return false;  // exterior on the left
+  auto corner = [&](OpenMesh::HalfedgeHandle out) {
+    const int f = mesh.face_handle(out).idx();
+    const auto& fv = g.face_vertices[f];
+    const int c = fv[0] == w_idx ? 0 : (fv[1] == w_idx ? 1 : 2);
+    return g.corner_angle[3 * f + c];
+  };
+  auto h = mesh.next_halfedge_handle(h_in);  // w→x in face(u→w)
+  double beta = corner(h);
+  int guard = 0;
+  while (h != h_out) {
+    const int e = mesh.edge_handle(h).idx();
+    const int z = mesh.to_vertex_handle(h).idx();
+    const int sign = w_idx < z ? +1 : -1;
+    const auto opp = mesh.opposite_halfedge_handle(h);
+    if (mesh.is_boundary(opp)) return false;  // the left side runs through the exterior
+    term(e, sign);
+    kappa_sum += sign * g.kappa[e];
+    h = mesh.next_halfedge_handle(opp);
+    beta += corner(h);
+    if (++guard > 10000) return false;
+  }
+  angle_term += M_PI - beta;
+  return true;
+}
+
+// W = (Σ_Γ κ + Σ_w (π − β_w))/2π, an integer up to round-off (a built-in check).
+long integral_winding(double kappa_sum, double angle_term, const std::string& name) {
+  const double W = (kappa_sum + angle_term) / (2 * M_PI);
+  const long Wi = std::lround(W);
+  if (std::abs(W - Wi) > 1e-6)
+    throw QsError("internal error: non-integral winding " + std::to_string(W) + " along " + name);
+  return Wi;
+}
+
+// Σ_Γ p = sectors_term − 4W for the closed vertex path, Γ its left face strip (§1.3).
 CycleEquation path_equation(const TriMesh& mesh, const GeometryCache& g,
                             const std::vector<int>& path, long sectors_term,
-                            const std::string& name);
+                            const std::string& name) {
+  CycleEquation eq;
+  const int len = static_cast<int>(path.size());
+  double kappa_sum = 0, angle_term = 0;
+  for (int k = 0; k < len; ++k) {
+    if (!left_strip_at(mesh, g, path[(k + len - 1) % len], path[k], path[(k + 1) % len], kappa_sum,
+                       angle_term, [&](int e, int sign) {
+                         eq.terms.push_back({e, sign});
+                       }))
+      return eq;
+  }
+  eq.rhs = sectors_term - 4 * integral_winding(kappa_sum, angle_term, name);
+  eq.ok = true;
+  return eq;
+}
 
-CycleEquation cycle_equation(const TriMesh& mesh, const GeometryCache& g, const Layout& layout,
-                             const LayoutTopology& topo,
-                             const std::vector<std::pair<int, bool>>& cycle) {
-  // Closed vertex path and the half-arcs at each node.
-  std::vector<int> path;
-  long sectors_term = 0;  // Σ (2 − s_i)
+// Σ (2 − s_i) over the nodes of a layout cycle: s_i sectors on its left at node i.
+long cycle_sectors_term(const LayoutTopology& topo,
+                        const std::vector<std::pair<int, bool>>& cycle) {
+  long sectors_term = 0;
   const int m = static_cast<int>(cycle.size());
   for (int i = 0; i < m; ++i) {
     const auto [a, fwd] = cycle[i];
-    const auto& p = layout.arcs[a].path;
-    if (fwd)
-      path.insert(path.end(), p.begin(), p.end() - 1);
-    else
-      path.insert(path.end(), p.rbegin(), p.rend() - 1);
     // Node at the start of this arc: h_out leaves along it, h_in is the previous arc's end.
     const int h_out = fwd ? 2 * a : 2 * a + 1;
     const auto [pa, pfwd] = cycle[(i + m - 1) % m];
@@ -181,56 +247,91 @@ CycleEquation cycle_equation(const TriMesh& mesh, const GeometryCache& g, const 
     const int s = ((pos_in - pos_out) % val + val) % val;
     sectors_term += 2 - s;
   }
-  return path_equation(mesh, g, path, sectors_term,
-                       "layout cycle (arcs " + arc_list(layout, cycle) + ")");
+  return sectors_term;
 }
 
-// Σ_Γ p = sectors_term − 4W for the closed vertex path, Γ its left face strip (§1.3).
-CycleEquation path_equation(const TriMesh& mesh, const GeometryCache& g,
-                            const std::vector<int>& path, long sectors_term,
-                            const std::string& name) {
-  CycleEquation eq;
-  const int len = static_cast<int>(path.size());
-  double kappa_sum = 0, angle_term = 0;
-  for (int k = 0; k < len; ++k) {
-    const auto u = mesh.vertex_handle(path[(k + len - 1) % len]);
-    const auto w = mesh.vertex_handle(path[k]);
-    const auto y = mesh.vertex_handle(path[(k + 1) % len]);
-    const auto h_in = mesh.find_halfedge(u, w);
-    const auto h_out = mesh.find_halfedge(w, y);
-    if (mesh.is_boundary(h_in) || mesh.is_boundary(h_out)) return eq;  // exterior on the left
-    auto corner = [&](OpenMesh::HalfedgeHandle out) {
-      const int f = mesh.face_handle(out).idx();
-      const auto& fv = g.face_vertices[f];
-      const int c = fv[0] == w.idx() ? 0 : (fv[1] == w.idx() ? 1 : 2);
-      return g.corner_angle[3 * f + c];
-    };
-    auto h = mesh.next_halfedge_handle(h_in);  // w→x in face(u→w)
-    double beta = corner(h);
-    int guard = 0;
-    while (h != h_out) {
-      const int e = mesh.edge_handle(h).idx();
-      const int z = mesh.to_vertex_handle(h).idx();
-      const int sign = w.idx() < z ? +1 : -1;
-      const auto opp = mesh.opposite_halfedge_handle(h);
-      if (mesh.is_boundary(opp)) return eq;  // the left side runs through the exterior
-      eq.terms.push_back({e, sign});
-      kappa_sum += sign * g.kappa[e];
-      h = mesh.next_halfedge_handle(opp);
-      beta += corner(h);
-      if (++guard > 10000) return eq;
-    }
-    angle_term += M_PI - beta;
-  }
-  const double W = (kappa_sum + angle_term) / (2 * M_PI);
-  const long Wi = std::lround(W);
-  if (std::abs(W - Wi) > 1e-6) {
-    throw QsError("internal error: non-integral winding " + std::to_string(W) + " along " + name);
-  }
-  eq.rhs = sectors_term - 4 * Wi;
-  eq.ok = true;
-  return eq;
+// Path vertex k of an arc traversed forward or backward.
+int arc_vertex(const LayoutArc& arc, bool fwd, size_t k) {
+  return fwd ? arc.path[k] : arc.path[arc.path.size() - 1 - k];
 }
+
+// Left-strip sums of directed arcs, cached: every layout cycle is a concatenation of arcs, and
+// the strip at an arc's interior vertices depends on that arc and direction only (arcs near the
+// root of the layout's spanning tree lie on many fundamental cycles).
+class ArcStrips {
+ public:
+  ArcStrips(const TriMesh& mesh, const GeometryCache& g, const Layout& layout, const AffineRows& p)
+      : mesh_(mesh),
+        g_(g),
+        layout_(layout),
+        p_(p),
+        sums_(2 * layout.arcs.size(), p.n),
+        state_(2 * layout.arcs.size(), 0),
+        kappa_(2 * layout.arcs.size(), 0.0),
+        angle_(2 * layout.arcs.size(), 0.0) {}
+
+  //! Row (Σ_Γ sign·p_e as an affine function) and rhs of a layout cycle; false when its left
+  //! side runs through the exterior.
+  bool equation(const LayoutTopology& topo, const std::vector<std::pair<int, bool>>& cycle,
+                long* row, long* b) {
+    const int n = p_.n;
+    std::fill(row, row + n, 0L);
+    long c = 0;
+    double kappa_sum = 0, angle_term = 0;
+    const int m = static_cast<int>(cycle.size());
+    for (int i = 0; i < m; ++i) {
+      const auto [a, fwd] = cycle[i];
+      const auto [pa, pfwd] = cycle[(i + m - 1) % m];
+      const LayoutArc& arc = layout_.arcs[a];
+      const LayoutArc& prev = layout_.arcs[pa];
+      // The node vertex at the start of arc i.
+      const int u = arc_vertex(prev, pfwd, prev.path.size() - 2);
+      const int w = arc_vertex(arc, fwd, 0), y = arc_vertex(arc, fwd, 1);
+      if (!left_strip_at(mesh_, g_, u, w, y, kappa_sum, angle_term, [&](int e, int sign) {
+            c += sign * p_.c[e];
+            const long* pr = p_.row(e);
+            for (int k = 0; k < n; ++k) row[k] += sign * pr[k];
+          }))
+        return false;
+      // The arc's interior vertices.
+      const size_t d = 2 * static_cast<size_t>(a) + (fwd ? 0 : 1);
+      if (!state_[d]) compute(d, a, fwd);
+      if (state_[d] < 0) return false;
+      c += sums_.c[d];
+      const long* sr = sums_.row(d);
+      for (int k = 0; k < n; ++k) row[k] += sr[k];
+      kappa_sum += kappa_[d];
+      angle_term += angle_[d];
+    }
+    const double W = (kappa_sum + angle_term) / (2 * M_PI);
+    if (std::abs(W - std::round(W)) > 1e-6)
+      integral_winding(kappa_sum, angle_term,
+                       "layout cycle (arcs " + arc_list(layout_, cycle) + ")");
+    const long rhs = cycle_sectors_term(topo, cycle) - 4 * std::lround(W);
+    *b = rhs - c;
+    return true;
+  }
+
+ private:
+  void compute(size_t d, int a, bool fwd) {
+    const LayoutArc& arc = layout_.arcs[a];
+    bool ok = true;
+    for (size_t k = 1; ok && k + 1 < arc.path.size(); ++k) {
+      ok = left_strip_at(mesh_, g_, arc_vertex(arc, fwd, k - 1), arc_vertex(arc, fwd, k),
+                         arc_vertex(arc, fwd, k + 1), kappa_[d], angle_[d],
+                         [&](int e, int sign) { sums_.add(d, sign, p_, e); });
+    }
+    state_[d] = ok ? 1 : -1;
+  }
+
+  const TriMesh& mesh_;
+  const GeometryCache& g_;
+  const Layout& layout_;
+  const AffineRows& p_;
+  AffineRows sums_;
+  std::vector<signed char> state_;  // 0 unknown, 1 ok, -1 runs through the exterior
+  std::vector<double> kappa_, angle_;
+};
 
 }  // namespace
 
@@ -307,42 +408,48 @@ std::vector<int> compute_period_jumps(const TriMesh& mesh, const GeometryCache& 
   rep.free_unknowns = nfree;
 
   // 3. Solve the vertex equations leaves-first; p as affine functions of the free unknowns.
-  std::vector<Affine> p(ne);
-  for (int e = 0; e < ne; ++e) {
-    p[e].coef.assign(nfree, 0);
-    if (is_free[e]) p[e].coef[free_index[e]] = 1;
-  }
-  // All interior edges around each interior vertex.
-  std::vector<std::vector<int>> around(nv);
+  AffineRows p(ne, nfree);
+  for (int e = 0; e < ne; ++e)
+    if (is_free[e]) p.row(e)[free_index[e]] = 1;
+  // All interior edges around each interior vertex (compressed rows).
+  std::vector<int> around_start(nv + 1, 0), around;
   for (int e = 0; e < ne; ++e) {
     if (!interior_edge(g, e)) continue;
-    around[g.edge_vertices[e][0]].push_back(e);
-    around[g.edge_vertices[e][1]].push_back(e);
+    ++around_start[g.edge_vertices[e][0] + 1];
+    ++around_start[g.edge_vertices[e][1] + 1];
   }
-  auto residual = [&](int v) {  // c_v − Σ_ccw p, as affine
-    Affine r;
-    r.c = i0[v] - target[v];
-    r.coef.assign(nfree, 0);
-    for (int e : around[v]) {
-      const int s = ccw_sign(g, e, v);
-      r.c -= s * p[e].c;
-      for (int k = 0; k < nfree; ++k) r.coef[k] -= s * p[e].coef[k];
+  for (int v = 0; v < nv; ++v) around_start[v + 1] += around_start[v];
+  around.resize(around_start[nv]);
+  {
+    std::vector<int> fill(around_start.begin(), around_start.end() - 1);
+    for (int e = 0; e < ne; ++e) {
+      if (!interior_edge(g, e)) continue;
+      around[fill[g.edge_vertices[e][0]]++] = e;
+      around[fill[g.edge_vertices[e][1]]++] = e;
     }
-    return r;
+  }
+  AffineRows r(1, nfree);  // c_v − Σ_ccw p at one vertex
+  auto residual = [&](int v) {
+    r.c[0] = i0[v] - target[v];
+    std::fill(r.coef.begin(), r.coef.end(), 0L);
+    for (int k = around_start[v]; k < around_start[v + 1]; ++k) {
+      const int e = around[k];
+      r.add(0, -ccw_sign(g, e, v), p, e);
+    }
   };
   for (auto it = order.rbegin(); it != order.rend(); ++it) {
     const int x = *it;
     if (x == root || x >= nv) continue;  // boundary loops: handled through free unknowns
     const int e = parent_edge[x];
     // p_e currently 0; solve s·p_e = residual.
-    const Affine r = residual(x);
+    residual(x);
     const int s = ccw_sign(g, e, x);
-    p[e].c = s * r.c;
-    for (int k = 0; k < nfree; ++k) p[e].coef[k] = s * r.coef[k];
+    p.c[e] = s * r.c[0];
+    for (int k = 0; k < nfree; ++k) p.row(e)[k] = s * r.coef[k];
   }
   if (nb == 0) {
-    const Affine r = residual(root);
-    bool zero = r.c == 0;
+    residual(root);
+    bool zero = r.c[0] == 0;
     for (long c : r.coef) zero = zero && c == 0;
     if (!zero) {
       long total = 0;
@@ -359,23 +466,20 @@ std::vector<int> compute_period_jumps(const TriMesh& mesh, const GeometryCache& 
   std::vector<std::vector<long>> rows;
   std::vector<long> rhs;
   std::vector<int> row_cycle;
+  ArcStrips strips(mesh, g, layout, p);
   for (size_t c = 0; c < cycles.size(); ++c) {
-    CycleEquation eq = cycle_equation(mesh, g, layout, topo, cycles[c]);
-    if (!eq.ok) {
+    std::vector<long> row(nfree, 0);
+    long b = 0;
+    bool ok = strips.equation(topo, cycles[c], row.data(), &b);
+    if (!ok) {
       auto reversed = cycles[c];
       std::reverse(reversed.begin(), reversed.end());
       for (auto& [a, fwd] : reversed) fwd = !fwd;
-      eq = cycle_equation(mesh, g, layout, topo, reversed);
+      ok = strips.equation(topo, reversed, row.data(), &b);
     }
-    if (!eq.ok) {
+    if (!ok) {
       ++rep.cycles_skipped;
       continue;
-    }
-    std::vector<long> row(nfree, 0);
-    long b = eq.rhs;
-    for (auto [e, s] : eq.terms) {
-      b -= s * p[e].c;
-      for (int k = 0; k < nfree; ++k) row[k] += s * p[e].coef[k];
     }
     rows.push_back(std::move(row));
     rhs.push_back(b);
@@ -408,8 +512,8 @@ std::vector<int> compute_period_jumps(const TriMesh& mesh, const GeometryCache& 
       std::vector<long> row(nfree, 0);
       long b = eq.rhs;
       for (auto [e, s] : eq.terms) {
-        b -= s * p[e].c;
-        for (int k = 0; k < nfree; ++k) row[k] += s * p[e].coef[k];
+        b -= s * p.c[e];
+        for (int k = 0; k < nfree; ++k) row[k] += s * p.row(e)[k];
       }
       rows.push_back(row);
       if (rank_of(rows) > current) {
@@ -453,17 +557,21 @@ std::vector<int> compute_period_jumps(const TriMesh& mesh, const GeometryCache& 
     long lhs = 0;
     for (int k = 0; k < nfree; ++k) lhs += rows[r][k] * gval[k];
     if (lhs != rhs[r]) {
-      throw TopologyError(
-          "the layout cycle through arcs " + arc_list(layout, cycles[row_cycle[r]]) +
-          " needs a cross-field turning of " + std::to_string(rhs[r] - lhs) +
-          " quarter turns that no field with singularities only at the nodes can have");
+      const std::string cycle =
+          row_cycle[r] >= 0
+              ? "the layout cycle through arcs " + arc_list(layout, cycles[row_cycle[r]])
+              : "boundary loop " + std::to_string(-1 - row_cycle[r]);
+      throw TopologyError(cycle + " needs a cross-field turning of " +
+                          std::to_string(rhs[r] - lhs) +
+                          " quarter turns that no field with singularities only at the nodes "
+                          "can have");
     }
   }
 
   std::vector<int> out(ne, 0);
   for (int e = 0; e < ne; ++e) {
-    long val = p[e].c;
-    for (int k = 0; k < nfree; ++k) val += p[e].coef[k] * gval[k];
+    long val = p.c[e];
+    for (int k = 0; k < nfree; ++k) val += p.row(e)[k] * gval[k];
     out[e] = static_cast<int>(val);
     rep.max_abs_jump = std::max(rep.max_abs_jump, std::abs(out[e]));
   }
