@@ -50,6 +50,12 @@ struct SceneData {
   //! Quad mesh overlay (null: none).
   const QuadOverlay* quads = nullptr;
   std::uint64_t quads_version = 0;
+  //! Cross field of the job's latest step (null: none), for the glyph layer.
+  const FieldView* field = nullptr;
+  std::uint64_t field_version = 0;
+  //! Free-hand stroke being drawn (points on the surface, drawing order); part of the
+  //! interaction state (interaction_version).
+  std::vector<glm::vec3> stroke_points;
 };
 
 //! Per-frame drawing context.

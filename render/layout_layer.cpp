@@ -184,6 +184,8 @@ void LayoutLayer::upload(const SceneData& data) {
       if (valid_vertex(mesh, v)) poly.push_back(vertex_position(mesh, v));
     push_polyline(lines, poly, LayoutColors::kPreview, arc_width * 0.8f);
   }
+  if (data.stroke_points.size() >= 2)
+    push_polyline(lines, data.stroke_points, LayoutColors::kPreview, arc_width * 0.7f);
   for (int v : data.issue_vertices)
     if (valid_vertex(mesh, v))
       push_point(issues, vertex_position(mesh, v), LayoutColors::kProblem, 0.9f, node_size * 0.8f,

@@ -79,6 +79,43 @@ PolyMesh quad_disk(int nx, int ny) {
   return mesh;
 }
 
+//! Flat n × n quad grid without its top-right cell: a disk with one concave corner whose two
+//! separatrices cut thin strips (one cell wide) off the top and right sides.
+PolyMesh notched_disk(int n) {
+  PolyMesh mesh;
+  std::map<std::array<int, 2>, VH> ids;
+  auto at = [&](int i, int j) {
+    auto it = ids.find({i, j});
+    if (it != ids.end()) return it->second;
+    const VH v = mesh.add_vertex(Vec3(i, j, 0));
+    ids.emplace(std::array<int, 2>{i, j}, v);
+    return v;
+  };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      if (i != n - 1 || j != n - 1)
+        mesh.add_face(std::vector<VH>{at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+  return mesh;
+}
+
+//! Checks the derived fields of a complex: valences, half-arc lists, arc ends.
+void expect_consistent(const QuadComplex& qc, const std::string& what) {
+  ASSERT_EQ(qc.valence.size(), qc.node_vertex.size()) << what;
+  ASSERT_EQ(qc.node_half_arcs.size(), qc.node_vertex.size()) << what;
+  std::vector<int> ends(qc.node_vertex.size(), 0);
+  for (const auto& arc : qc.arcs) {
+    ASSERT_GE(arc.path.size(), 2u) << what;
+    EXPECT_EQ(arc.path.front(), qc.node_vertex[arc.from]) << what;
+    EXPECT_EQ(arc.path.back(), qc.node_vertex[arc.to]) << what;
+    ++ends[arc.from];
+    ++ends[arc.to];
+  }
+  for (size_t n = 0; n < qc.node_vertex.size(); ++n) {
+    EXPECT_EQ(qc.valence[n], ends[n]) << what << " node " << n;
+    EXPECT_EQ(static_cast<int>(qc.node_half_arcs[n].size()), ends[n]) << what << " node " << n;
+  }
+}
+
 TEST(BaseComplex, CubeHasEightCornersTwelveArcsSixPatches) {
   for (int k : {1, 2, 5}) {
     const PolyMesh cube = quad_cube(k);
@@ -202,6 +239,129 @@ TEST(BaseComplex, RealQuadMeshes) {
     int irregular_nodes = 0;
     for (int v : qc.valence) irregular_nodes += v != 4;
     EXPECT_EQ(irregular_nodes, c.irregular) << c.file;
+  }
+}
+
+TEST(BaseComplexCoarsen, ThinBoundaryStripsCollapseToOnePatch) {
+  const PolyMesh disk = notched_disk(8);
+  const QuadComplex full = base_complex(disk);
+  // Corners (0,0), (8,0), (0,8), (8,7), (7,8), the concave corner (7,7) and the two boundary
+  // T-nodes (7,0), (0,7): three patches, two of them one cell wide.
+  EXPECT_EQ(full.node_vertex.size(), 8u);
+  EXPECT_EQ(full.num_patches, 3);
+  CoarsenOptions options;
+  options.max_width = 0.5;  // thinner than any strip: nothing changes
+  CoarsenStats stats;
+  const QuadComplex same = coarsen_complex(disk, full, options, &stats);
+  EXPECT_EQ(stats.chords_collapsed, 0);
+  EXPECT_EQ(same.node_vertex, full.node_vertex);
+  EXPECT_TRUE(same.simple_paths);
+
+  // The two one-cell strips (the second one is up to 2 edges wide after the first collapse
+  // moved its corner), not the 7-cell ones.
+  options.max_width = 2.5;
+  const QuadComplex coarse = coarsen_complex(disk, full, options, &stats);
+  EXPECT_TRUE(stats.skipped.empty()) << stats.skipped;
+  EXPECT_EQ(stats.chords_collapsed, 2);
+  EXPECT_EQ(stats.nodes_before, 8);
+  EXPECT_EQ(stats.patches_before, 3);
+  EXPECT_EQ(coarse.node_vertex.size(), 4u);
+  EXPECT_EQ(coarse.arcs.size(), 4u);
+  EXPECT_EQ(coarse.num_patches, 1);
+  EXPECT_EQ(stats.nodes_after, 4);
+  EXPECT_FALSE(coarse.simple_paths);
+  expect_consistent(coarse, "notched disk");
+  for (int v : coarse.valence) EXPECT_EQ(v, 2);
+  // All nodes stay on the boundary, within one cell of a corner of the 8 x 8 square.
+  for (int v : coarse.node_vertex) {
+    EXPECT_TRUE(disk.is_boundary(VH(v)));
+    const Vec3 p = disk.point(VH(v));
+    const double dx = std::min(p[0], 8 - p[0]), dy = std::min(p[1], 8 - p[1]);
+    EXPECT_LE(dx, 1.0);
+    EXPECT_LE(dy, 1.0);
+  }
+}
+
+TEST(BaseComplexCoarsen, ThinBoxKeepsItsCorners) {
+  // A 6 x 6 x 1 box: the chord around the thin side is one cell wide, but collapsing it would
+  // merge the valence-3 corners pairwise into valence-2 nodes (a degenerate pillow), so the
+  // valence rule keeps the 8-corner layout.
+  PolyMesh box;
+  std::map<std::array<int, 3>, VH> lattice;
+  const std::array<int, 3> size{6, 6, 1};
+  auto vertex = [&](std::array<int, 3> p) {
+    auto it = lattice.find(p);
+    if (it != lattice.end()) return it->second;
+    const VH v = box.add_vertex(Vec3(p[0], p[1], p[2]));
+    lattice.emplace(p, v);
+    return v;
+  };
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int side : {0, size[axis]}) {
+      int b = (axis + 1) % 3, c = (axis + 2) % 3;
+      if (side == 0) std::swap(b, c);
+      for (int i = 0; i < size[b]; ++i) {
+        for (int j = 0; j < size[c]; ++j) {
+          std::array<int, 3> p{};
+          p[axis] = side;
+          auto at = [&](int di, int dj) {
+            std::array<int, 3> q = p;
+            q[b] = i + di;
+            q[c] = j + dj;
+            return vertex(q);
+          };
+          box.add_face(std::vector<VH>{at(0, 0), at(1, 0), at(1, 1), at(0, 1)});
+        }
+      }
+    }
+  }
+  const QuadComplex full = base_complex(box);
+  ASSERT_EQ(full.node_vertex.size(), 8u);
+  CoarsenOptions options;
+  options.max_width = 1.5;
+  CoarsenStats stats;
+  const QuadComplex coarse = coarsen_complex(box, full, options, &stats);
+  EXPECT_EQ(stats.chords_collapsed, 0);
+  EXPECT_EQ(coarse.node_vertex.size(), 8u);
+  EXPECT_EQ(coarse.num_patches, 6);
+}
+
+TEST(BaseComplexCoarsen, RealDenseComplexesGetSmallerAndKeepTopology) {
+  const std::string dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real quad meshes skipped";
+  struct Case {
+    std::string quads, target;
+    int euler;  // V - E + F of the surface
+  };
+  for (const Case& c : {Case{"quadwild_joint/joint_rem_p_quadrangulation.obj",
+                             "quadwild_joint/joint_rem_p.obj", -2},
+                        Case{"inspired_mesh/inspired_mesh_quads_Conjugate.off",
+                             "inspired_mesh/inspired_mesh.obj", 1}}) {
+    const PolyMesh quads = load_poly_mesh(dir + "/" + c.quads);
+    const TriMesh target = load_mesh(dir + "/" + c.target);
+    double sum = 0;
+    for (const auto e : target.edges()) sum += target.calc_edge_length(e);
+    const QuadComplex full = base_complex(quads);
+    CoarsenOptions options;
+    options.max_width = 4.0 * sum / target.n_edges();
+    CoarsenStats stats;
+    const QuadComplex coarse = coarsen_complex(quads, full, options, &stats);
+    EXPECT_TRUE(stats.skipped.empty()) << c.quads << ": " << stats.skipped;
+    EXPECT_GT(stats.chords_collapsed, 0) << c.quads;
+    EXPECT_LT(coarse.node_vertex.size(), full.node_vertex.size()) << c.quads;
+    EXPECT_LT(coarse.num_patches, full.num_patches) << c.quads;
+    EXPECT_EQ(static_cast<int>(full.node_vertex.size() - full.arcs.size()) + full.num_patches,
+              c.euler)
+        << c.quads;
+    EXPECT_EQ(static_cast<int>(coarse.node_vertex.size() - coarse.arcs.size()) + coarse.num_patches,
+              c.euler)
+        << c.quads;
+    expect_consistent(coarse, c.quads);
+    // Merged nodes keep valences in the allowed ranges.
+    for (size_t n = 0; n < coarse.node_vertex.size(); ++n) {
+      const bool boundary = quads.is_boundary(VH(coarse.node_vertex[n]));
+      EXPECT_GE(coarse.valence[n], boundary ? 2 : 3) << c.quads << " node " << n;
+    }
   }
 }
 

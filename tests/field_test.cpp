@@ -340,6 +340,7 @@ TEST(CrossField, RelaxedWarmStartRoundsLikeTheLargestClusterWarmStart) {
   int multi = 0;
   for (const auto& in : cases) {
     CrossFieldOptions relaxed, largest;
+    relaxed.warm_start = ClusterWarmStart::Relaxed;
     largest.warm_start = ClusterWarmStart::LargestCluster;
     const Solved a = solve_field(in, 0, relaxed), b = solve_field(in, 0, largest);
     multi += a.field.clusters > 1;

@@ -10,6 +10,8 @@
 #include "app/gui/pipeline_job.h"
 #include "core/layout/layout_io.h"
 #include "core/mesh/mesh_io.h"
+#include "core/nodeopt/optimizer.h"
+#include "core/pipeline/pipeline.h"
 
 namespace qs::app {
 namespace {
@@ -101,4 +103,43 @@ TEST(GuiJob, ExportWithoutQuadMeshFailsClearly) {
 }
 
 }  // namespace
+
+// Each node-optimization step displays the Pipeline the optimizer hands back (no second solve):
+// its energy is the one of a Pipeline built from scratch on the step's mesh and layout.
+TEST(GuiJob, DisplayedStepMatchesFreshSolve) {
+  const Example ex = example();
+  Worker worker(pipeline_step);
+  WorkerOptions options;
+  options.max_steps = 3;  // initial solve + two node-optimization steps
+  options.publish_interval_ms = 0;
+  worker.send(cmd::SetOptions{options});
+  worker.send(cmd::LoadMesh{ex.mesh, ex.layout});
+  worker.send(cmd::Run{});
+  const auto s = worker.wait_for(
+      [](const Snapshot& x) {
+        return x.status == WorkerStatus::Finished || x.status == WorkerStatus::Failed;
+      },
+      120s);
+  ASSERT_EQ(s->status, WorkerStatus::Finished) << s->message;
+  ASSERT_TRUE(s->exports);
+  Layout layout = s->exports->layout;
+  for (auto& arc : layout.arcs) arc.polyline.clear(), arc.samples.clear(), arc.label.clear();
+  layout.patches.clear();
+  qs::PipelineOptions po;  // as the job sets them from WorkerOptions
+  po.field.constraints.curvature = options.align;
+  po.field.constraints.sharp_angle_deg = options.sharp_angle_deg;
+  po.param.anisotropy = options.anisotropy;
+  qs::Pipeline fresh(s->exports->mesh, layout, po);
+  const double E = fresh.compute_parameterization().energy;
+  // The optimizer's last solve may add the orientation constraints (when the plain one folds).
+  qs::PipelineOptions oriented = po;
+  oriented.param.orientation = qs::NodeOptOptions{}.orientation;
+  oriented.param.orientation.enabled = true;
+  qs::Pipeline fresh_oriented(s->exports->mesh, layout, oriented);
+  const double E_oriented = fresh_oriented.compute_parameterization().energy;
+  EXPECT_TRUE(std::abs(s->energy - E) <= 1e-9 * E || std::abs(s->energy - E_oriented) <= 1e-9 * E)
+      << "displayed " << s->energy << ", fresh " << E << ", fresh oriented " << E_oriented;
+  ASSERT_EQ(s->exports->corner_uv.size(), fresh.parameterization()->corner_uv.size());
+}
+
 }  // namespace qs::app

@@ -1,9 +1,11 @@
 // Driver for the GUI smoke tests (registered in tests/cmake/gui_smoke.cmake).
 //
 //   gui_smoke_check screenshot --app A --mesh M --layout L --out PNG [--width W --height H]
-//     Runs `xvfb-run ... A --mesh M --layout L --screenshot PNG --frames 5 --quit` and checks
-//     the picture: expected size, the centre differs from the background, and it has edges
-//     (wireframe, arcs). Exits 77 (CTest skip) when xvfb-run is not installed.
+//                   [--expect-colors "r,g,b,min;..."] [-- app arguments...]
+//     Runs `xvfb-run ... A --mesh M --layout L --screenshot PNG --frames 5 --quit` (no --frames
+//     when the extra arguments contain --run) and checks the picture: expected size, the centre
+//     differs from the background, it has edges (wireframe, arcs), and each expected colour
+//     covers enough pixels. Exits 77 (CTest skip) when xvfb-run is not installed.
 //   gui_smoke_check exit-code --app A --expect N [app arguments...]
 //     Runs the app (no display needed when it fails before opening a window) and checks its
 //     exit code.
@@ -39,7 +41,27 @@ bool on_path(const std::string& program) {
   return run("command -v " + program + " > /dev/null 2>&1") == 0;
 }
 
-int check_screenshot(const std::map<std::string, std::string>& args) {
+// "r,g,b,min;r,g,b,min": colours (0-255) of which at least `min` pixels (each channel within
+// 40) must appear right of the side panel.
+struct ColorCheck {
+  int r = 0, g = 0, b = 0, min = 0;
+};
+std::vector<ColorCheck> parse_colors(const std::string& text) {
+  std::vector<ColorCheck> out;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    const std::size_t end = std::min(text.find(';', start), text.size());
+    ColorCheck c;
+    if (std::sscanf(text.substr(start, end - start).c_str(), "%d,%d,%d,%d", &c.r, &c.g, &c.b,
+                    &c.min) == 4)
+      out.push_back(c);
+    start = end + 1;
+  }
+  return out;
+}
+
+int check_screenshot(const std::map<std::string, std::string>& args,
+                     const std::vector<std::string>& rest) {
   if (!on_path("xvfb-run")) {
     std::printf("SKIPPED: xvfb-run is not installed (apt-get install xvfb xauth)\n");
     return kSkip;
@@ -53,10 +75,17 @@ int check_screenshot(const std::map<std::string, std::string>& args) {
       return 1;
     }
   std::filesystem::remove(png);
-  const std::string command =
-      "xvfb-run -a -s '-screen 0 " + std::to_string(want_w) + "x" + std::to_string(want_h) +
-      "x24' " + quote(args.at("--app")) + " --mesh " + quote(args.at("--mesh")) + " --layout " +
-      quote(args.at("--layout")) + " --screenshot " + quote(png) + " --frames 5 --quit";
+  std::string command = "xvfb-run -a -s '-screen 0 " + std::to_string(want_w) + "x" +
+                        std::to_string(want_h) + "x24' " + quote(args.at("--app")) + " --mesh " +
+                        quote(args.at("--mesh")) + " --layout " + quote(args.at("--layout")) +
+                        " --screenshot " + quote(png) + " --quit";
+  // Extra app arguments after "--"; a run takes its screenshot when it finishes.
+  bool runs = false;
+  for (const auto& a : rest) {
+    command += " " + quote(a);
+    runs = runs || a == "--run";
+  }
+  if (!runs) command += " --frames 5";
   const int code = run(command);
   if (code != 0) {
     std::printf("FAIL: quadsketch exited with %d\n", code);
@@ -89,6 +118,20 @@ int check_screenshot(const std::map<std::string, std::string>& args) {
       for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(at(x, y, c) - at(bx, y, c)));
       differing += d > 24;
       strong_gradients += std::abs(luma(x + 1, y) - luma(x, y)) > 40;
+    }
+  }
+  const auto colors = parse_colors(args.count("--expect-colors") ? args.at("--expect-colors") : "");
+  for (const auto& c : colors) {
+    int found = 0;
+    for (int y = 0; y < h; ++y)
+      for (int x = w * 30 / 100; x < w; ++x)
+        found += std::abs(at(x, y, 0) - c.r) <= 40 && std::abs(at(x, y, 1) - c.g) <= 40 &&
+                 std::abs(at(x, y, 2) - c.b) <= 40;
+    std::printf("colour (%d, %d, %d): %d pixels, expected at least %d\n", c.r, c.g, c.b, found,
+                c.min);
+    if (found < c.min) {
+      std::printf("FAIL: too few pixels of colour (%d, %d, %d)\n", c.r, c.g, c.b);
+      ++failures;
     }
   }
   stbi_image_free(pixels);
@@ -138,7 +181,7 @@ int main(int argc, char** argv) {
   }
   for (; i < argc; ++i) rest.push_back(argv[i]);
   try {
-    if (mode == "screenshot") return check_screenshot(args);
+    if (mode == "screenshot") return check_screenshot(args, rest);
     if (mode == "exit-code") return check_exit_code(args, rest);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "gui_smoke_check: %s (missing argument?)\n", e.what());

@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +16,7 @@
 #include "app/gui/recent_files.h"
 #include "core/base/atomic_file.h"
 #include "core/layout/layout_io.h"
+#include "core/layout/validate.h"
 
 namespace qs::app {
 namespace {
@@ -209,6 +213,239 @@ TEST_F(LayoutEditorTest, OnChangeFiresForEditsUndoAndRedo) {
   editor_.undo();
   editor_.redo();
   EXPECT_EQ(calls, 3);
+}
+
+// The surface point at (x, y) of grid(n) (face and barycentrics in face-vertex order).
+SurfacePoint grid_point(const TriMesh& mesh, double x, double y, int n = 10) {
+  const int i = std::clamp(int(x * n), 0, n - 1), j = std::clamp(int(y * n), 0, n - 1);
+  const double lx = x * n - i, ly = y * n - j;
+  SurfacePoint p;
+  p.face = 2 * (j * n + i) + (lx >= ly ? 0 : 1);
+  // Weights of the corners (i, j), (i+1, j), (i+1, j+1), (i, j+1) for this triangle.
+  const double w[4] = {lx >= ly ? 1 - lx : 1 - ly, lx >= ly ? lx - ly : 0.0, lx >= ly ? ly : lx,
+                       lx >= ly ? 0.0 : ly - lx};
+  const int corner[4] = {vid(i, j, n), vid(i + 1, j, n), vid(i + 1, j + 1, n), vid(i, j + 1, n)};
+  int k = 0;
+  for (const auto vh : mesh.fv_range(OpenMesh::FaceHandle(p.face))) {
+    double b = 0.0;
+    for (int c = 0; c < 4; ++c)
+      if (corner[c] == vh.idx()) b = w[c];
+    p.bary[k++] = b;
+  }
+  return p;
+}
+
+// Mouse-like samples every `step` along the polyline through `corners` (x, y).
+std::vector<SurfacePoint> stroke_through(const TriMesh& mesh,
+                                         const std::vector<std::array<double, 2>>& corners,
+                                         double step = 0.02) {
+  std::vector<SurfacePoint> out;
+  for (std::size_t k = 0; k + 1 < corners.size(); ++k) {
+    const auto a = corners[k], b = corners[k + 1];
+    const double len = std::hypot(b[0] - a[0], b[1] - a[1]);
+    const int count = std::max(1, int(std::ceil(len / step)));
+    for (int s = 0; s < count; ++s) {
+      const double t = double(s) / count;
+      out.push_back(grid_point(mesh, a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])));
+    }
+  }
+  out.push_back(grid_point(mesh, corners.back()[0], corners.back()[1]));
+  return out;
+}
+
+Vec3 position(const TriMesh& mesh, int v) {
+  return mesh.point(OpenMesh::VertexHandle(v));
+}
+
+void expect_edge_path(const TriMesh& mesh, const std::vector<int>& path) {
+  for (std::size_t i = 0; i + 1 < path.size(); ++i)
+    EXPECT_TRUE(
+        mesh.find_halfedge(OpenMesh::VertexHandle(path[i]), OpenMesh::VertexHandle(path[i + 1]))
+            .is_valid())
+        << "no mesh edge between " << path[i] << " and " << path[i + 1];
+}
+
+TEST_F(LayoutEditorTest, StrokeArcFollowsTheStrokeNotTheShortestPath) {
+  const int a = editor_.add_node(vid(1, 1)).id;
+  const int b = editor_.add_node(vid(9, 1)).id;
+  // A U-shaped stroke: up the left side, across at y = 0.8, down the right side.
+  const auto stroke = stroke_through(mesh_, {{0.1, 0.1}, {0.1, 0.8}, {0.9, 0.8}, {0.9, 0.1}});
+  const auto r = editor_.add_stroke_arc(a, b, stroke);
+  ASSERT_TRUE(r.ok) << r.error;
+  const Layout& layout = editor_.layout();
+  const LayoutArc& arc = layout.arcs[layout.arc_index(r.id)];
+  EXPECT_EQ(arc.from, a);
+  EXPECT_EQ(arc.to, b);
+  ASSERT_GE(arc.path.size(), 2u);
+  EXPECT_EQ(arc.path.front(), vid(1, 1));
+  EXPECT_EQ(arc.path.back(), vid(9, 1));
+  expect_edge_path(mesh_, arc.path);
+  // Every vertex stays within one edge length of the stroke, and the route reaches its top.
+  double top = 0.0;
+  for (int v : arc.path) {
+    const Vec3 x = position(mesh_, v);
+    const double d =
+        std::min({std::abs(x[0] - 0.1) + std::max(0.0, x[1] - 0.8),
+                  std::abs(x[0] - 0.9) + std::max(0.0, x[1] - 0.8),
+                  std::abs(x[1] - 0.8) + std::max(0.0, std::max(0.1 - x[0], x[0] - 0.9))});
+    EXPECT_LE(d, 0.1 + 1e-9) << "vertex " << v << " strays from the stroke";
+    top = std::max(top, x[1]);
+  }
+  EXPECT_NEAR(top, 0.8, 1e-9);
+  // Click-click routing of the same nodes takes the short way instead.
+  ASSERT_TRUE(editor_.undo());
+  const auto straight = editor_.add_arc(a, b);
+  ASSERT_TRUE(straight.ok);
+  for (int v : editor_.layout().arcs.back().path) EXPECT_LE(position(mesh_, v)[1], 0.1 + 1e-9);
+}
+
+TEST_F(LayoutEditorTest, StrokeIntoEmptySpaceAddsTheEndNodeInTheSameUndoStep) {
+  const int a = editor_.add_node(vid(1, 1)).id;
+  const std::string before = dump(editor_.layout());
+  const auto history = editor_.history_size();
+  const auto r = editor_.add_stroke_arc(a, -1, stroke_through(mesh_, {{0.1, 0.1}, {0.52, 0.48}}));
+  ASSERT_TRUE(r.ok) << r.error;
+  ASSERT_GE(r.node_id, 0);
+  const Layout& layout = editor_.layout();
+  ASSERT_EQ(layout.nodes.size(), 2u);
+  EXPECT_EQ(layout.nodes[layout.node_index(r.node_id)].vertex, vid(5, 5));
+  const LayoutArc& arc = layout.arcs[layout.arc_index(r.id)];
+  EXPECT_EQ(arc.to, r.node_id);
+  EXPECT_EQ(arc.path.back(), vid(5, 5));
+  expect_edge_path(mesh_, arc.path);
+  EXPECT_EQ(editor_.history_size(), history + 1);
+  const std::string after = dump(editor_.layout());
+  ASSERT_TRUE(editor_.undo());
+  EXPECT_EQ(dump(editor_.layout()), before);
+  ASSERT_TRUE(editor_.redo());
+  EXPECT_EQ(dump(editor_.layout()), after);
+  // Ending at an existing node uses it instead of adding one.
+  const int c = editor_.add_node(vid(9, 2)).id;
+  const auto r2 =
+      editor_.add_stroke_arc(r.node_id, -1, stroke_through(mesh_, {{0.5, 0.5}, {0.9, 0.21}}));
+  ASSERT_TRUE(r2.ok) << r2.error;
+  EXPECT_EQ(r2.node_id, -1);
+  EXPECT_EQ(editor_.layout().arcs.back().to, c);
+}
+
+TEST_F(LayoutEditorTest, StrokeArcsAvoidOtherArcs) {
+  sketch_square();
+  const int inner = editor_.add_node(vid(5, 5)).id;
+  // Drawn straight over the square's bottom arc towards a corner node (reachable from inside
+  // over the diagonal edge (3, 3)-(2, 2)): the route may not share any vertex or edge with the
+  // other arcs.
+  const RoutingObstacles obstacles = obstacles_of_layout(mesh_, editor_.layout());
+  const auto r = editor_.add_stroke_arc(
+      inner, ids_[0], stroke_through(mesh_, {{0.5, 0.5}, {0.5, 0.2}, {0.2, 0.2}}));
+  ASSERT_TRUE(r.ok) << r.error;
+  const auto& path = editor_.layout().arcs.back().path;
+  expect_edge_path(mesh_, path);
+  for (std::size_t i = 1; i + 1 < path.size(); ++i)
+    EXPECT_FALSE(obstacles.vertex_blocked[path[i]]) << "vertex " << path[i] << " is taken";
+  // Leaving the closed square is impossible without crossing an arc: refused, nothing changes.
+  const std::string before = dump(editor_.layout());
+  const auto out =
+      editor_.add_stroke_arc(inner, -1, stroke_through(mesh_, {{0.5, 0.5}, {0.5, 0.05}}));
+  EXPECT_FALSE(out.ok);
+  EXPECT_FALSE(out.error.empty());
+  EXPECT_EQ(dump(editor_.layout()), before);
+}
+
+TEST_F(LayoutEditorTest, InvalidStrokesAreRefusedWithAMessage) {
+  sketch_square();
+  const std::string before = dump(editor_.layout());
+  const auto history = editor_.history_size();
+  const auto good = stroke_through(mesh_, {{0.2, 0.2}, {0.5, 0.5}});
+  auto bad_face = good;
+  bad_face[3].face = 100000;
+  auto nan_bary = good;
+  nan_bary[2].bary = {std::nan(""), 0.5, 0.5};
+  const std::vector<EditResult> refused = {
+      editor_.add_stroke_arc(ids_[0], ids_[2], {}),              // empty
+      editor_.add_stroke_arc(ids_[0], ids_[2], {good.front()}),  // one sample
+      editor_.add_stroke_arc(999, ids_[2], good),                // unknown start
+      editor_.add_stroke_arc(ids_[0], 999, good),                // unknown end
+      editor_.add_stroke_arc(ids_[0], ids_[0], good),            // loop
+      editor_.add_stroke_arc(ids_[0], ids_[2], bad_face),        // face out of range
+      editor_.add_stroke_arc(ids_[0], ids_[2], nan_bary),        // NaN barycentrics
+      editor_.add_stroke_arc(ids_[0], -1, stroke_through(mesh_, {{0.2, 0.2}, {0.5, 0.21}})),
+  };
+  for (std::size_t k = 0; k < refused.size(); ++k) {
+    EXPECT_FALSE(refused[k].ok) << "stroke " << k;
+    EXPECT_FALSE(refused[k].error.empty()) << "stroke " << k;
+  }
+  EXPECT_NE(refused.back().error.find("arc"), std::string::npos) << refused.back().error;
+  EXPECT_EQ(dump(editor_.layout()), before);
+  EXPECT_EQ(editor_.history_size(), history);
+}
+
+TEST_F(LayoutEditorTest, RouteStrokeToTheBoundaryEndsNearTheLastSample) {
+  std::string error;
+  const RoutingObstacles none = obstacles_of_layout(mesh_, Layout{});
+  const auto path =
+      route_stroke(mesh_, vid(5, 5), -1,
+                   stroke_through(mesh_, {{0.5, 0.5}, {0.7, 0.7}, {0.98, 0.7}}), none, &error);
+  ASSERT_GE(path.size(), 2u) << error;
+  EXPECT_EQ(path.back(), vid(10, 7));
+  expect_edge_path(mesh_, path);
+}
+
+TEST_F(LayoutEditorTest, DanglingArcEndsOnTheBoundary) {
+  const int a = editor_.add_node(vid(4, 5)).id;
+  const std::string before = dump(editor_.layout());
+  // Nearest free boundary vertex: 4 edges to the left.
+  const auto r = editor_.add_dangling_arc(a);
+  ASSERT_TRUE(r.ok) << r.error;
+  const Layout& layout = editor_.layout();
+  const LayoutArc& arc = layout.arcs[layout.arc_index(r.id)];
+  EXPECT_TRUE(arc.dangling());
+  EXPECT_EQ(arc.path.front(), vid(4, 5));
+  EXPECT_EQ(arc.path.back(), vid(0, 5));
+  EXPECT_EQ(arc.path.size(), 5u);
+  expect_edge_path(mesh_, arc.path);
+  EXPECT_EQ(node_valence(layout, a), 1);
+  for (const auto& issue : validate_layout(mesh_, layout).issues)
+    EXPECT_NE(issue.code, "dangling_not_on_boundary") << issue.message;
+  // A chosen boundary vertex; the taken one and interior vertices are refused.
+  const auto r2 = editor_.add_dangling_arc(a, vid(10, 5));
+  ASSERT_TRUE(r2.ok) << r2.error;
+  EXPECT_EQ(editor_.layout().arcs.back().path.back(), vid(10, 5));
+  const std::string two = dump(editor_.layout());
+  EXPECT_FALSE(editor_.add_dangling_arc(a, vid(0, 5)).ok);  // taken by the first arc
+  EXPECT_FALSE(editor_.add_dangling_arc(a, vid(5, 6)).ok);  // not on the boundary
+  EXPECT_FALSE(editor_.add_dangling_arc(a, 100000).ok);     // out of range
+  EXPECT_FALSE(editor_.add_dangling_arc(999).ok);           // unknown node
+  EXPECT_EQ(dump(editor_.layout()), two);
+  ASSERT_TRUE(editor_.undo());
+  ASSERT_TRUE(editor_.undo());
+  EXPECT_EQ(dump(editor_.layout()), before);
+}
+
+TEST(LayoutEditorClosed, DanglingArcsNeedABoundary) {
+  // An octahedron: closed, so a dangling arc has nowhere to end.
+  TriMesh mesh;
+  std::vector<OpenMesh::VertexHandle> v;
+  for (const auto& p : {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0), Vec3(0, 0, 1),
+                        Vec3(0, 0, -1)})
+    v.push_back(mesh.add_vertex(p));
+  const int faces[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                           {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  for (const auto& f : faces) mesh.add_face(v[f[0]], v[f[1]], v[f[2]]);
+  ASSERT_EQ(mesh.n_faces(), 8u);
+  LayoutEditor editor;
+  editor.reset(&mesh, Layout{});
+  const int a = editor.add_node(0).id;
+  const auto r = editor.add_dangling_arc(a);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.error.find("boundary"), std::string::npos) << r.error;
+  EXPECT_TRUE(editor.layout().arcs.empty());
+  // The stroke router says the same for a stroke that should end on the boundary.
+  std::string error;
+  SurfacePoint p;
+  p.face = 0;
+  EXPECT_TRUE(
+      route_stroke(mesh, 0, -1, {p, p}, obstacles_of_layout(mesh, Layout{}), &error).empty());
+  EXPECT_NE(error.find("boundary"), std::string::npos) << error;
 }
 
 class ScopedEnv {

@@ -7,8 +7,13 @@
 #include <cstdlib>
 #include <queue>
 
+#include "core/layout/base_complex.h"
+#include "core/layout/layout_io.h"
+#include "core/layout/perturb.h"
+#include "core/layout/quad_import.h"
 #include "core/layout/validate.h"
 #include "core/mesh/geometry.h"
+#include "core/mesh/mesh_io.h"
 #include "core/nodeopt/discrete.h"
 #include "core/nodeopt/geodesic.h"
 #include "core/nodeopt/gradient.h"
@@ -269,8 +274,9 @@ struct Recorder : Observer {
 void expect_monotone(const NodeOptResult& r, const Recorder& rec) {
   double last = r.E_init;
   for (const auto& s : rec.steps) {
-    if (s.phase != "descent" || !s.accepted) continue;
-    EXPECT_LE(s.E, last * (1 + 1e-12)) << "accepted step " << s.step << " raised E";
+    if ((s.phase != "descent" && s.phase != "hop") || !s.accepted) continue;
+    EXPECT_LE(s.E, last * (1 + 1e-12))
+        << "accepted " << s.phase << " step " << s.step << " raised E";
     last = s.E;
   }
   EXPECT_NEAR(r.E_descent, last, 1e-12 * last);
@@ -331,26 +337,211 @@ TEST(NodeOptimizer, DescendsOnPerturbedEllipsoid) {
   expect_valid_mesh(in.mesh, r.mesh);
 }
 
-TEST(NodeOptimizer, RecoversFromDisplacedNodes) {
-  const auto in = test::cube_sphere(8);
-  const NodeOptResult exact = optimize_nodes(in.mesh, in.layout, PipelineOptions{});
-  const double E_star = exact.E_final;
-  const Layout start = perturb_layout(in.mesh, in.layout, 3, 4);
+// Pentagonal prism (two pentagons, five side quads) split once into quads (split_to_quads), each
+// quad refined k×k, triangulated and projected onto an ellipsoid with the given radii. Layout:
+// its base complex: 10 valence-3 corners, 2 valence-5 pentagon centres, 10 valence-4 crossings.
+test::MeshAndLayout pentagonal_prism(int k, Vec3 radii) {
+  PolyMesh prism;
+  std::vector<PolyMesh::VertexHandle> top, bottom;
+  for (int i = 0; i < 5; ++i) {
+    const double a = 2 * M_PI * i / 5;
+    top.push_back(prism.add_vertex(Vec3(std::cos(a), std::sin(a), 0.7)));
+    bottom.push_back(prism.add_vertex(Vec3(std::cos(a), std::sin(a), -0.7)));
+  }
+  prism.add_face(top);
+  prism.add_face(std::vector<PolyMesh::VertexHandle>(bottom.rbegin(), bottom.rend()));
+  for (int i = 0; i < 5; ++i) {
+    const int j = (i + 1) % 5;
+    prism.add_face(std::vector<PolyMesh::VertexHandle>{bottom[i], bottom[j], top[j], top[i]});
+  }
+  const PolyMesh quads = split_to_quads(prism);
+  const QuadComplex complex = base_complex(quads);
+  test::MeshAndLayout out{triangulate_quads(quads, k), layout_on_triangulation(quads, complex, k)};
+  for (auto v : out.mesh.vertices()) {
+    const Vec3 p = out.mesh.point(v).normalized();
+    out.mesh.set_point(v, Vec3(p[0] * radii[0], p[1] * radii[1], p[2] * radii[2]));
+  }
+  return out;
+}
+
+// Recovery (issue #5): optimize the exact layout (E*), displace every node by 3 rings
+// (core/layout/perturb) and optimize again.
+struct RecoveryOutcome {
+  double E_star = 0, E_init = 0, E_final = 0;
+  int foldovers_final = 0, hop_rounds = 0, hops = 0;
+};
+
+// \p compare: also run the continuous descent alone and print its ratio.
+RecoveryOutcome run_recovery(const char* name, const test::MeshAndLayout& in, unsigned seed,
+                             bool compare) {
+  const NodeOptOptions no;
+  RecoveryOutcome out;
+  const NodeOptResult exact = optimize_nodes(in.mesh, in.layout, PipelineOptions{}, no);
+  out.E_star = exact.E_final;
+  PerturbLayoutOptions po;
+  po.rings = 3;
+  po.seed = seed;
+  const PerturbResult perturbed = qs::perturb_layout(in.mesh, in.layout, po);
   Recorder rec;
-  const NodeOptResult r = optimize_nodes(in.mesh, start, PipelineOptions{}, {}, &rec);
+  const NodeOptResult r = optimize_nodes(in.mesh, perturbed.layout, PipelineOptions{}, no, &rec);
+  out.E_init = r.E_init;
+  out.E_final = r.E_final;
+  out.foldovers_final = r.foldovers_final;
+  out.hop_rounds = r.hop_rounds;
+  out.hops = r.hops;
+  if (compare) {
+    NodeOptOptions plain = no;
+    plain.hop_polish = false;
+    const NodeOptResult p = optimize_nodes(in.mesh, perturbed.layout, PipelineOptions{}, plain);
+    std::printf("[stat] recovery %s seed %u without the hop polish: %.4f E*, %d steps\n", name,
+                seed, p.E_final / out.E_star, p.steps);
+    EXPECT_LE(r.E_descent, p.E_descent * (1 + 1e-9)) << "the polish only adds to the descent";
+  }
   std::printf(
-      "[stat] recovery: E* %.6g (from exact layout, E_init %.6g); perturbed 3 rings "
-      "E %.6g -> %.6g = %.4f E*, %d steps, fold-overs %d -> %d, %.2f s\n",
-      E_star, exact.E_init, r.E_init, r.E_final, r.E_final / E_star, r.steps, r.foldovers_init,
+      "[stat] recovery %s seed %u: E* %.6g (exact E_init %.6g); %zu of %zu nodes displaced 3 "
+      "rings: E %.6g -> %.6g = %.4f E*, %d steps, %d hop sweeps (%d hops), fold-overs %d -> "
+      "%d, %.2f s\n",
+      name, seed, out.E_star, exact.E_init, perturbed.moved_nodes.size(), in.layout.nodes.size(),
+      r.E_init, r.E_final, r.E_final / out.E_star, r.steps, r.hop_rounds, r.hops, r.foldovers_init,
       r.foldovers_final, r.time_s);
   expect_monotone(r, rec);
-  // Issue #5 asks for E_final <= 1.05·E*; the descent currently stalls at ~1.4·E* (the step
-  // length collapses after relocations; see the note on issue #5). Asserted here is what
-  // holds today, so that a regression still fails: most of the displacement energy is removed
-  // and the fold-overs are gone.
-  EXPECT_LE(r.E_final - E_star, 0.1 * (r.E_init - E_star));
-  EXPECT_EQ(r.foldovers_final, 0);
+  EXPECT_TRUE(validate_layout(r.mesh, r.layout).valid());
   expect_valid_mesh(in.mesh, r.mesh);
+  return out;
+}
+
+// Issue #5 asks for E_final <= 1.05·E* and no fold-overs. The torus grid meets it for every
+// seed (0.9997–1.0007 E*). On the cube-on-sphere / ellipsoid and the prism it depends on the
+// seed: 0.95–1.6 E*, with the hop polish never above the descent alone (sphere seed 3: 1.74 ->
+// 1.43 E*, prism seed 2: 1.64 -> 1.25 E*). The optimum reached is a collective one: on the
+// sphere the nodes end at a rigidly rotated cube (node residual 0.07–0.2 edges after the
+// best-fit rotation, 0.8–2.2 edges before), whose estimated gradients point away from the exact
+// vertices; single-node hops and the continuous descent both raise E there. Asserted for those
+// cases: 0 fold-overs and at least 90 % of the displacement energy removed (observed ≥ 95 %).
+void expect_recovered(const RecoveryOutcome& o, bool within_5_percent) {
+  EXPECT_EQ(o.foldovers_final, 0);
+  EXPECT_LE(o.E_final - o.E_star, 0.1 * (o.E_init - o.E_star));
+  if (within_5_percent) {
+    EXPECT_LE(o.E_final, 1.05 * o.E_star);
+  }
+}
+
+TEST(NodeOptimizer, RecoversFromDisplacedNodesOnTorusGrid) {
+  const auto torus = test::torus_grid(32, 16, 4, 2);
+  for (unsigned seed : {1u, 2u, 3u})
+    expect_recovered(run_recovery("torus", torus, seed, false), true);
+}
+
+TEST(NodeOptimizer, RecoversFromDisplacedNodesOnSphereAndEllipsoid) {
+  const auto sphere = test::cube_sphere(8);
+  const auto ellipsoid = test::cube_sphere(8, Vec3(1.3, 1, 0.75));
+  for (unsigned seed : {1u, 2u, 3u}) {
+    expect_recovered(run_recovery("sphere", sphere, seed, true), false);
+    expect_recovered(run_recovery("ellipsoid", ellipsoid, seed, true), false);
+  }
+}
+
+TEST(NodeOptimizer, RecoversFromDisplacedNodesWithValence5) {
+  const auto prism = pentagonal_prism(6, Vec3(1.15, 1, 0.85));
+  for (unsigned seed : {1u, 2u, 3u})
+    expect_recovered(run_recovery("prism5", prism, seed, false), false);
+}
+
+// Without fold-over removal the optimizer returns the state with the fewest fold-overs of the
+// polished state and the state before the first hop (NodeOptResult::polish_reverted); either
+// way the returned (mesh, layout) re-solves to the reported E_descent and fold-overs.
+TEST(NodeOptimizer, HopPolishReturnsConsistentState) {
+  const auto in = test::cube_sphere(8);
+  NodeOptOptions no;
+  no.orientation_at_end = false;
+  no.stiffen_at_end = false;
+  int polished = 0;
+  for (int seed : {6, 7, 8}) {
+    const Layout start = perturb_layout(in.mesh, in.layout, 4, seed);
+    Recorder rec;
+    const NodeOptResult r = optimize_nodes(in.mesh, start, PipelineOptions{}, no, &rec);
+    int last_folds = -1;
+    for (const auto& s : rec.steps)
+      if ((s.phase == "descent" || s.phase == "hop") && s.accepted) last_folds = s.foldovers;
+    std::printf(
+        "[stat] polish without fold-over removal, seed %d: E %.6g -> %.6g, %d hops, fold-overs "
+        "%d -> %d (last accepted step %d), reverted %d\n",
+        seed, r.E_init, r.E_final, r.hops, r.foldovers_init, r.foldovers_final, last_folds,
+        r.polish_reverted);
+    polished += r.hops > 0;
+    Pipeline fresh(r.mesh, r.layout, PipelineOptions{});
+    fresh.compute_field();
+    const Parameterization& pf = fresh.compute_parameterization();
+    const double E = unweighted_energy(fresh.mesh(), fresh.geometry(), fresh.field()->theta,
+                                       pf.corner_uv, PipelineOptions{}.param);
+    EXPECT_NEAR(E, r.E_descent, 1e-9 * E);
+    EXPECT_EQ(pf.foldovers, r.foldovers_final);
+    EXPECT_EQ(r.E_final, r.E_descent);
+    if (last_folds >= 0) {
+      EXPECT_LE(r.foldovers_final, last_folds);
+    }
+    if (r.polish_reverted) {
+      EXPECT_LT(r.foldovers_final, last_folds);
+    } else {
+      expect_monotone(r, rec);
+    }
+    EXPECT_LE(r.E_final, r.E_init);
+  }
+  EXPECT_GT(polished, 0) << "no case exercised the polish";
+}
+
+// hop_sweep (the discrete baseline's step and the optimizer's polish): a node displaced by one
+// edge from its exact vertex hops back when its neighbours are tried, E drops to the exact
+// layout's value and the other nodes stay.
+TEST(DiscreteRelocation, HopSweepReturnsDisplacedNode) {
+  const auto in = test::cube_sphere(8, Vec3(1.3, 1, 0.75));
+  const PipelineOptions options;
+  const HopEvaluator evaluate = [&](const TriMesh& m, const Layout& l, double& E, int& folds) {
+    Pipeline p(m, l, options);
+    p.compute_field();
+    const Parameterization& r = p.compute_parameterization();
+    E = unweighted_energy(p.mesh(), p.geometry(), p.field()->theta, r.corner_uv, options.param);
+    folds = r.foldovers;
+    return true;
+  };
+  double E_exact = 0, E = 0;
+  int folds = 0;
+  evaluate(in.mesh, in.layout, E_exact, folds);
+  Layout layout = in.layout;
+  const int node = 2, exact_vertex = in.layout.nodes[node].vertex;
+  int displaced = -1;
+  for (int w : ring_vertices(in.mesh, exact_vertex, 1))
+    if (!forbidden_relocation_vertices(in.mesh, layout, node)[w] &&
+        move_node_and_reroute(in.mesh, layout, node, w)) {
+      displaced = w;
+      break;
+    }
+  ASSERT_GE(displaced, 0);
+  evaluate(in.mesh, layout, E, folds);
+  ASSERT_GT(E, E_exact);
+  TriMesh mesh = in.mesh;
+  // Preferring the direction away from the exact vertex finds nothing better.
+  const Vec3 back = in.mesh.point(in.mesh.vertex_handle(exact_vertex)) -
+                    in.mesh.point(in.mesh.vertex_handle(displaced));
+  HopSweepOptions away;
+  away.max_candidates = 1;
+  away.min_direction_cos = 0.5;
+  Layout unchanged = layout;
+  const HopSweepResult none =
+      hop_sweep(in.mesh, mesh, unchanged, {node}, {-back}, E, folds, away, evaluate);
+  EXPECT_EQ(none.moved, 0);
+  EXPECT_EQ(unchanged.nodes[node].vertex, displaced);
+  EXPECT_EQ(none.E, E);
+  // All neighbours: the node returns.
+  const HopSweepResult s = hop_sweep(in.mesh, mesh, layout, {node}, {}, E, folds, {}, evaluate);
+  std::printf("[stat] hop sweep: E %.6g -> %.6g (exact %.6g), %d evaluations\n", E, s.E, E_exact,
+              s.evaluations);
+  EXPECT_EQ(s.moved, 1);
+  EXPECT_EQ(layout.nodes[node].vertex, exact_vertex);
+  EXPECT_LT(s.E, E);
+  EXPECT_NEAR(s.E, E_exact, 1e-6 * E_exact);
+  for (size_t n = 0; n < layout.nodes.size(); ++n)
+    EXPECT_EQ(layout.nodes[n].vertex, in.layout.nodes[n].vertex);
 }
 
 TEST(NodeOptimizer, PinnedNodesKeepTheirPosition) {
@@ -440,6 +631,176 @@ TEST(DiscreteRelocation, LowersEnergy) {
   EXPECT_LT(r.E_final, r.E_init);
   EXPECT_TRUE(validate_layout(r.mesh, r.layout).valid());
   for (const auto& s : rec.steps) EXPECT_LE(s.E, r.E_init * (1 + 1e-12));
+}
+
+// ---------------------------------------------------------------------------------------------
+// (f) reuse across steps (issue #5 speed): the shortcuts must not change results
+
+// The local structure check of move_node_and_reroute (rotation at the affected nodes + patch
+// count) accepts exactly the moves that the full validation accepts, with the same routes.
+TEST(Relocation, LocalCheckAgreesWithFullValidation) {
+  const auto in = test::cube_sphere(6, Vec3(1.3, 1, 0.75));
+  RelocationOptions fast, full;
+  full.full_validation = true;
+  const RerouteContext context = make_reroute_context(in.mesh, in.layout);
+  EXPECT_TRUE(context.sphere);
+  EXPECT_EQ(context.patches, static_cast<int>(build_topology(in.mesh, in.layout).patches.size()));
+  const auto torus = test::torus_grid(16, 8, 4, 2);
+  EXPECT_FALSE(make_reroute_context(torus.mesh, torus.layout).sphere);
+  const auto disk = test::disk_grid(8, 8, 2, 2);
+  EXPECT_FALSE(make_reroute_context(disk.mesh, disk.layout).sphere);
+  int accepted = 0, tried = 0;
+  for (int n = 0; n < static_cast<int>(in.layout.nodes.size()); ++n) {
+    for (int rings = 1; rings <= 3; ++rings) {
+      for (int w : ring_vertices(in.mesh, in.layout.nodes[n].vertex, rings)) {
+        Layout a = in.layout, b = in.layout, c = in.layout;
+        const bool ok_fast = move_node_and_reroute(in.mesh, a, n, w, fast);
+        const bool ok_full = move_node_and_reroute(in.mesh, b, n, w, full);
+        const bool ok_sphere = move_node_and_reroute(in.mesh, c, n, w, fast, &context);
+        ++tried;
+        accepted += ok_fast;
+        ASSERT_EQ(ok_fast, ok_full) << "node " << n << " to vertex " << w;
+        ASSERT_EQ(ok_sphere, ok_full) << "node " << n << " to vertex " << w;
+        for (size_t k = 0; k < a.arcs.size(); ++k) {
+          ASSERT_EQ(a.arcs[k].path, b.arcs[k].path);
+          ASSERT_EQ(c.arcs[k].path, b.arcs[k].path);
+        }
+        if (ok_fast) {
+          EXPECT_TRUE(validate_layout(in.mesh, a).valid());
+        }
+      }
+    }
+  }
+  std::printf("[stat] relocation check: %d of %d moves accepted\n", accepted, tried);
+  EXPECT_GT(accepted, 0);
+  EXPECT_LT(accepted, tried);  // some moves (onto other arcs, order changes) are refused
+}
+
+// Re-solving a Pipeline after its vertices moved (update_positions: geometry updated in place,
+// κ continued, solver setup kept) gives the energy of a Pipeline built from scratch.
+TEST(Pipeline, UpdatePositionsMatchesFreshPipeline) {
+  const auto in = test::cube_sphere(8, Vec3(1.3, 1, 0.75));
+  const Layout start = perturb_layout(in.mesh, in.layout, 2, 5);
+  PipelineOptions options;
+  Pipeline reused(in.mesh, start, options);
+  reused.compute_field();
+  const double E0 = unweighted_energy(reused.mesh(), reused.geometry(), reused.field()->theta,
+                                      reused.compute_parameterization().corner_uv, options.param);
+  // Move every node vertex and some others a quarter of the way to a neighbour.
+  TriMesh moved = in.mesh;
+  std::vector<char> pick(moved.n_vertices(), 0);
+  for (const auto& node : start.nodes) pick[node.vertex] = 1;
+  for (int v = 0; v < static_cast<int>(moved.n_vertices()); v += 7) pick[v] = 1;
+  for (auto v : moved.vertices()) {
+    if (!pick[v.idx()]) continue;
+    const auto w = *moved.vv_range(v).begin();
+    moved.set_point(v, in.mesh.point(v) + 0.25 * (in.mesh.point(w) - in.mesh.point(v)));
+  }
+  for (int round = 0; round < 2; ++round) {  // twice: a second update continues from the first
+    const TriMesh& target = round == 0 ? moved : in.mesh;
+    reused.update_positions(target);
+    reused.compute_field();
+    const Parameterization& pr = reused.compute_parameterization();
+    const double E_reused = unweighted_energy(reused.mesh(), reused.geometry(),
+                                              reused.field()->theta, pr.corner_uv, options.param);
+    Pipeline fresh(target, start, options);
+    fresh.compute_field();
+    const Parameterization& pf = fresh.compute_parameterization();
+    const double E_fresh = unweighted_energy(fresh.mesh(), fresh.geometry(), fresh.field()->theta,
+                                             pf.corner_uv, options.param);
+    EXPECT_NEAR(E_reused, E_fresh, 1e-9 * E_fresh) << "round " << round;
+    EXPECT_EQ(pr.foldovers, pf.foldovers);
+    if (round == 0) {
+      EXPECT_GT(std::abs(E_fresh - E0), 1e-3 * E0) << "the move changed nothing";
+    }
+    if (round == 1) {
+      EXPECT_NEAR(E_reused, E0, 1e-9 * E0);
+    }
+  }
+  EXPECT_THROW(reused.update_positions(test::cube_sphere(6).mesh), InvalidInputError);
+}
+
+// The optimizer's reuse (in-place re-solves, kept gradients, the returned Pipeline, a warm
+// start) reproduces fresh Pipelines on the same states.
+TEST(NodeOptimizer, ReuseMatchesFreshPipelines) {
+  const auto in = test::cube_sphere(8, Vec3(1.3, 1, 0.75));
+  const Layout start = perturb_layout(in.mesh, in.layout, 2, 5);
+  PipelineOptions options;
+  NodeOptOptions no;
+  no.max_steps = 8;
+  NodeOptStats stats;
+  Recorder rec;
+  const NodeOptResult r = optimize_nodes(in.mesh, start, options, no, &rec, nullptr, &stats);
+  std::printf("[stat] reuse: %d steps, %d fresh pipelines, %d reused solves, %d kept gradients\n",
+              r.steps, stats.fresh_pipelines, stats.reused_solves, stats.gradient_reuses);
+  EXPECT_GT(stats.reused_solves, 0);
+  EXPECT_GT(stats.fresh_pipelines, 1);
+  ASSERT_TRUE(r.pipeline);
+  auto energy_of = [&](const Pipeline& p) {
+    return unweighted_energy(p.mesh(), p.geometry(), p.field()->theta,
+                             p.parameterization()->corner_uv, options.param);
+  };
+  Pipeline fresh(r.mesh, r.layout, options);
+  fresh.compute_field();
+  fresh.compute_parameterization();
+  const double E_fresh = energy_of(fresh);
+  EXPECT_NEAR(r.E_descent, E_fresh, 1e-9 * E_fresh);
+  if (!r.orientation_constraints) {
+    EXPECT_NEAR(energy_of(*r.pipeline), E_fresh, 1e-9 * E_fresh);
+    // Warm start from the returned Pipeline: the initial E is the same without a fresh solve.
+    NodeOptOptions one = no;
+    one.max_steps = 1;
+    NodeOptStats warm;
+    const NodeOptResult r2 =
+        optimize_nodes(r.mesh, r.layout, options, one, nullptr, r.pipeline, &warm);
+    EXPECT_NEAR(r2.E_init, E_fresh, 1e-9 * E_fresh);
+    EXPECT_TRUE(warm.warm_start);
+  }
+  // A Pipeline of another state is not taken as the start.
+  NodeOptOptions one = no;
+  one.max_steps = 1;
+  NodeOptStats other;
+  auto stale = std::make_shared<Pipeline>(in.mesh, in.layout, options);
+  stale->compute_parameterization();
+  const NodeOptResult r3 = optimize_nodes(in.mesh, start, options, one, nullptr, stale, &other);
+  EXPECT_FALSE(other.warm_start);
+  EXPECT_NEAR(r3.E_init, r.E_init, 1e-12 * r.E_init);
+}
+
+// The same on the bundled example (curvature-aligned field with constraint clusters), one
+// step at a time with the warm start, as the editor runs it.
+TEST(NodeOptimizer, ReuseMatchesFreshPipelinesOnExample) {
+  const std::string dir = std::string(QS_ASSETS_DIR) + "/example/";
+  TriMesh mesh = load_mesh(dir + "ellipsoid.obj");
+  Layout layout = load_layout(dir + "ellipsoid.layout.json", mesh);
+  PipelineOptions options;
+  NodeOptOptions one;
+  one.max_steps = 1;
+  one.hop_polish = false;  // as the editor: one descent step per call
+  one.stiffen_at_end = false;
+  std::shared_ptr<Pipeline> warm;
+  for (int step = 0; step < 4; ++step) {
+    NodeOptStats stats;
+    const NodeOptResult r = optimize_nodes(mesh, layout, options, one, nullptr, warm, &stats);
+    Pipeline fresh(r.mesh, r.layout, options);
+    fresh.compute_field();
+    const Parameterization& pf = fresh.compute_parameterization();
+    const double E_fresh = unweighted_energy(fresh.mesh(), fresh.geometry(), fresh.field()->theta,
+                                             pf.corner_uv, options.param);
+    std::printf(
+        "[stat] example step %d: accepted %d, warm %d, fresh %d, reused %d, E %.12g vs fresh "
+        "%.12g\n",
+        step, r.accepted, stats.warm_start, stats.fresh_pipelines, stats.reused_solves, r.E_descent,
+        E_fresh);
+    EXPECT_NEAR(r.E_descent, E_fresh, 1e-9 * E_fresh) << "step " << step;
+    mesh = r.mesh;
+    layout = r.layout;
+    warm = r.descent_pipeline;
+    one.alpha *= r.accepted ? 1 : 0.5;
+    if (step > 0) {
+      EXPECT_TRUE(stats.warm_start);
+    }
+  }
 }
 
 }  // namespace

@@ -70,6 +70,24 @@ PolyMesh quad_torus(int nu, int nv) {
   return mesh;
 }
 
+//! Flat n × n quad grid without its top-right cell (two one-cell strips in its base complex).
+PolyMesh notched_disk(int n) {
+  PolyMesh mesh;
+  std::map<std::array<int, 2>, VH> ids;
+  auto at = [&](int i, int j) {
+    auto it = ids.find({i, j});
+    if (it != ids.end()) return it->second;
+    const VH v = mesh.add_vertex(Vec3(i, j, 0));
+    ids.emplace(std::array<int, 2>{i, j}, v);
+    return v;
+  };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      if (i != n - 1 || j != n - 1)
+        mesh.add_face(std::vector<VH>{at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+  return mesh;
+}
+
 void write_poly_obj(const PolyMesh& mesh, const std::string& path) {
   std::ofstream out(path);
   out.precision(17);
@@ -155,6 +173,25 @@ TEST(QuadImport, CubeBaseComplexOntoSphereLikeMesh) {
             .norm(),
         0.0, 1e-12);
   }
+}
+
+TEST(QuadImport, CoarsenedNotchedDiskIsOnePatch) {
+  QuadImportOptions options;
+  options.coarsen = 2.5;  // quad-mesh edge lengths (1 here)
+  options.refine = 3;
+  const QuadImportResult r = import_quads(notched_disk(8), nullptr, options);
+  EXPECT_EQ(r.coarsen.nodes_before, 8);
+  EXPECT_EQ(r.coarsen.patches_before, 3);
+  EXPECT_EQ(r.coarsen.chords_collapsed, 2);
+  expect_matches_complex(r, "notched disk");
+  EXPECT_EQ(r.layout.nodes.size(), 4u);
+  EXPECT_EQ(r.layout.arcs.size(), 4u);
+  EXPECT_EQ(r.complex.num_patches, 1);
+  // Without coarsening the exact base complex (3 patches) is kept.
+  options.coarsen = 0;
+  const QuadImportResult exact = import_quads(notched_disk(8), nullptr, options);
+  expect_matches_complex(exact, "notched disk, exact");
+  EXPECT_EQ(exact.complex.num_patches, 3);
 }
 
 TEST(QuadImport, FarFromTargetIsAnError) {
@@ -289,7 +326,49 @@ TEST_F(RealQuads, DenseComplexOntoCoarseTargetFailsClearly) {
     FAIL() << "expected InvalidInputError";
   } catch (const InvalidInputError& e) {
     EXPECT_NE(std::string(e.what()).find("too coarse"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--coarsen"), std::string::npos) << e.what();
   }
+}
+
+TEST_F(RealQuads, InspiredCoarsenedOntoItsTriangleMesh) {
+  // The staircase boundary makes almost every vertex a node of the base complex; collapsing its
+  // thin chords makes the transfer onto the (boundary) triangle mesh possible.
+  const PolyMesh quads = load_poly_mesh(dir_ + "/inspired_mesh/inspired_mesh_quads_Conjugate.off");
+  const TriMesh target = load_mesh(dir_ + "/inspired_mesh/inspired_mesh.obj");
+  QuadImportOptions options;
+  options.coarsen = 6;
+  const QuadImportResult r = import_quads(quads, &target, options);
+  expect_matches_complex(r, "inspired coarsened");
+  EXPECT_EQ(r.coarsen.nodes_before, 1749);
+  EXPECT_LT(r.coarsen.nodes_after, 200);
+  EXPECT_EQ(static_cast<int>(r.layout.nodes.size()), r.coarsen.nodes_after);
+  // A disk: one boundary loop, V - E + F = 1, covered by boundary arcs (no trimmed patch).
+  const LayoutTopology topo = build_topology(r.mesh, r.layout);
+  EXPECT_EQ(topo.num_nodes - topo.num_arcs + static_cast<int>(topo.patches.size()), 1);
+  for (const auto& patch : topo.patches) EXPECT_FALSE(patch.trimmed);
+  // Without coarsening the same transfer fails with a hint.
+  try {
+    import_quads(quads, &target, {});
+    FAIL() << "expected InvalidInputError";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--coarsen"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(RealQuads, JointCoarsenedOnItsOwnQuads) {
+  // The spiralling base complex of the QuadWild joint, coarsened by chord collapse, routed onto
+  // the quad mesh refined 3 x 3: a valid genus-2 layout with fewer patches.
+  QuadImportOptions options;
+  options.coarsen = 4;
+  options.refine = 3;
+  const QuadImportResult r = import_quads(
+      load_poly_mesh(dir_ + "/quadwild_joint/joint_rem_p_quadrangulation.obj"), nullptr, options);
+  expect_matches_complex(r, "joint coarsened");
+  EXPECT_GT(r.coarsen.chords_collapsed, 0);
+  EXPECT_LT(r.coarsen.nodes_after, r.coarsen.nodes_before);
+  EXPECT_EQ(static_cast<int>(r.layout.nodes.size()), r.coarsen.nodes_after);
+  const LayoutTopology topo = build_topology(r.mesh, r.layout);
+  EXPECT_EQ(topo.num_nodes - topo.num_arcs + static_cast<int>(topo.patches.size()), -2);
 }
 
 }  // namespace

@@ -53,12 +53,19 @@ int main(int argc, char** argv) {
                    "Like --quad-size, choosing the size for about N quads")
       ->check(CLI::PositiveNumber)
       ->excludes(quad_size_opt);
+  cmd_opt->add_flag("--integer", opt.integer,
+                    "Make every patch size an integer multiple of the quad size: optimize relaxed, "
+                    "round the arc lengths, optimize again with them fixed (needs --quad-size or "
+                    "--quad-count)");
   cmd_opt->add_option("--gradient", opt.gradient, "Node gradient: estimator or exact")
       ->check(CLI::IsMember({"estimator", "exact"}))
       ->capture_default_str();
   cmd_opt->add_flag("--no-align", opt.no_align, "Ignore curvature directions (baseline)");
   cmd_opt->add_flag("--discrete-relocation", opt.discrete_relocation,
                     "Move nodes vertex by vertex (baseline)");
+  cmd_opt->add_flag("--no-orientation", opt.no_orientation,
+                    "No orientation constraints against fold-overs after the node optimization "
+                    "(stiffening only)");
   cmd_opt->add_option("--sharp-angle", opt.sharp_angle_deg, "Sharp feature dihedral angle (deg)")
       ->capture_default_str();
   cmd_opt->add_option("--threads", opt.threads, "Number of threads")->capture_default_str();
@@ -74,6 +81,11 @@ int main(int argc, char** argv) {
       ->add_option("--refine", imp.refine, "Split each quad K x K before triangulating (no --onto)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  cmd_import
+      ->add_option("--coarsen", imp.coarsen,
+                   "Collapse the base complex's patch strips thinner than W mean edge lengths")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
 
   PerturbOptions perturb;
   auto* cmd_perturb = app.add_subcommand("perturb", "Move the nodes of a layout randomly");
@@ -82,6 +94,32 @@ int main(int argc, char** argv) {
   cmd_perturb->add_option("--rings", perturb.rings, "Edge rings to move each node")->required();
   cmd_perturb->add_option("--seed", perturb.seed, "Random seed")->required();
   cmd_perturb->add_option("--out", perturb.out, "Output layout JSON")->required();
+
+  CageLayoutOptions cage;
+  auto* cmd_cage = app.add_subcommand(
+      "cage-layout", "Make a layout for a closed triangle mesh from its voxel cage");
+  cmd_cage->add_option("--mesh", cage.mesh, "Closed triangle mesh")->required();
+  cmd_cage->add_option("--out", cage.out, "Output layout JSON")->required();
+  cmd_cage->add_option("--resolution", cage.resolution, "Voxel cells along the longest axis")
+      ->check(CLI::Range(2, 200))
+      ->capture_default_str();
+  cmd_cage->add_flag("--all-edges", cage.all_edges,
+                     "Every cage edge is an arc (one patch per cage quad) instead of the base "
+                     "complex");
+  cmd_cage->add_option("--smoothing", cage.smoothing, "Spring relaxation rounds of the fitted cage")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd_cage
+      ->add_option("--attempts", cage.attempts,
+                   "Grids to try (resolution, shifted, resolution + 1, ...) until one works")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd_cage
+      ->add_option("--coarsen", cage.coarsen,
+                   "Collapse cage chords at most this many voxel cells wide (0: off)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd_cage->add_option("--cage", cage.cage, "Also write the fitted quad cage (OBJ)");
 
   try {
     app.parse(argc, argv);
@@ -99,6 +137,7 @@ int main(int argc, char** argv) {
     if (*cmd_opt) return run_optimize(opt, common);
     if (*cmd_import) return run_import_quads(imp, common);
     if (*cmd_perturb) return run_perturb(perturb, common);
+    if (*cmd_cage) return run_cage_layout(cage, common);
   } catch (const qs::Cancelled&) {
     std::cerr << "error: cancelled (" << signal_name(received_signal()) << ")\n";
     return cancelled_exit_code();

@@ -64,6 +64,7 @@ int run_import_quads(const ImportQuadsOptions& o, const CommonOptions& common) {
     QuadImportOptions options;
     options.all_edges = o.all_edges;
     options.refine = o.refine;
+    options.coarsen = o.coarsen;
     const auto t_import = std::chrono::steady_clock::now();
     const QuadImportResult result =
         import_quads(quads, o.onto.empty() ? nullptr : &target, options);
@@ -85,11 +86,30 @@ int run_import_quads(const ImportQuadsOptions& o, const CommonOptions& common) {
                        {"faces", result.quads.n_faces()},
                        {"irregular_vertices", result.complex.irregular_vertices},
                        {"split", result.split},
-                       {"base_complex_patches", result.complex.num_patches}};
+                       {"base_complex_patches", result.coarsen.patches_before}};
+    if (o.coarsen > 0) {
+      report["coarsen"] = {{"width", o.coarsen},
+                           {"chords_collapsed", result.coarsen.chords_collapsed},
+                           {"before",
+                            {{"nodes", result.coarsen.nodes_before},
+                             {"arcs", result.coarsen.arcs_before},
+                             {"patches", result.coarsen.patches_before}}},
+                           {"after",
+                            {{"nodes", result.coarsen.nodes_after},
+                             {"arcs", result.coarsen.arcs_after},
+                             {"patches", result.coarsen.patches_after}}}};
+    }
     report["timings_s"] = {
         {"load", load_s}, {"import", import_s}, {"total", seconds_since(t_total)}};
     report["status"] = "ok";
     write_file_atomic(report_path, report.dump(2) + "\n");
+    if (!common.quiet && o.coarsen > 0) {
+      std::cerr << "import-quads: coarsened the base complex from " << result.coarsen.nodes_before
+                << " nodes / " << result.coarsen.arcs_before << " arcs / "
+                << result.coarsen.patches_before << " patches to " << result.coarsen.nodes_after
+                << " / " << result.coarsen.arcs_after << " / " << result.coarsen.patches_after
+                << " (" << result.coarsen.chords_collapsed << " chords collapsed)\n";
+    }
     if (!common.quiet) {
       std::cerr << "import-quads: " << report["layout"]["nodes"] << " nodes ("
                 << report["layout"]["irregular_nodes"] << " irregular), "

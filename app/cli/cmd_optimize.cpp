@@ -1,27 +1,34 @@
 // quadsketch-cli optimize: field → parameterization → (node optimization) → extraction.
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <optional>
 
 #include "app/cli/commands.h"
 #include "app/cli/report.h"
+#include "app/cli/signals.h"
 #include "core/extract/quads.h"
 #include "core/layout/layout_io.h"
 #include "core/mesh/mesh_io.h"
 #include "core/nodeopt/discrete.h"
 #include "core/nodeopt/gradient.h"
 #include "core/nodeopt/optimizer.h"
+#include "core/pipeline/integer_sizes.h"
 #include "core/pipeline/pipeline.h"
 
 namespace qs::cli {
 
 namespace {
 
-// Progress lines on stderr, one per node optimization step.
+// Progress lines on stderr, one per node optimization step. Forwards SIGINT/SIGTERM: the
+// optimizer stops at its next poll (between solves) instead of waiting for the watchdog.
 class ProgressPrinter : public Observer {
  public:
   explicit ProgressPrinter(bool quiet) : quiet_(quiet) {}
+  bool should_cancel() const override { return cancel_requested(); }
   void on_step(const StepReport& r) override {
     if (quiet_) return;
     std::cerr << "node optimization [" << r.phase << "] step " << r.step << ": E = " << r.E
@@ -49,35 +56,91 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     PipelineOptions options;
     options.field.constraints.sharp_angle_deg = o.sharp_angle_deg;
     options.field.constraints.curvature = !o.no_align;
+    if (o.integer && !(o.quad_size > 0 || o.quad_count > 0))
+      throw InvalidInputError("--integer needs --quad-size Q or --quad-count N");
     // Node optimization first (it runs its own field + parameterization solves); the final
     // stages below then run on its result.
     double node_s = 0;
     std::optional<NodeOptResult> node_result;
-    if (!o.no_node_opt) {
-      t0 = std::chrono::steady_clock::now();
-      ProgressPrinter printer(common.quiet);
+    ProgressPrinter printer(common.quiet);
+    const auto optimize = [&](const TriMesh& start_mesh, const Layout& start_layout,
+                              const PipelineOptions& run_options) {
       if (o.discrete_relocation) {
         DiscreteOptions d;
         d.max_steps = o.steps;
-        node_result = relocate_nodes_discrete(mesh, layout, options, d, &printer);
-      } else {
-        NodeOptOptions no;
-        no.max_steps = o.steps;
-        no.gradient = o.gradient == "exact" ? GradientMethod::Exact : GradientMethod::Estimator;
-        node_result = optimize_nodes(mesh, layout, options, no, &printer);
+        return relocate_nodes_discrete(start_mesh, start_layout, run_options, d, &printer);
       }
-      mesh = node_result->mesh;
-      layout = node_result->layout;
-      options.param.face_weights = node_result->face_weights;
+      NodeOptOptions no;
+      no.max_steps = o.steps;
+      no.gradient = o.gradient == "exact" ? GradientMethod::Exact : GradientMethod::Estimator;
+      no.orientation_at_end = !o.no_orientation;
+      return optimize_nodes(start_mesh, start_layout, run_options, no, &printer);
+    };
+    // After a run: its mesh, layout and the options of its final solve.
+    const auto adopt = [&](NodeOptResult result) {
+      mesh = result.mesh;
+      layout = result.layout;
+      options.param.face_weights = result.face_weights;
+      if (result.orientation_constraints)  // the final solve is the constrained one
+        options.param.orientation = result.orientation_options;
+      node_result = std::move(result);
+    };
+    if (!o.no_node_opt) {
+      t0 = std::chrono::steady_clock::now();
+      adopt(optimize(mesh, layout, options));
       node_s = seconds_since(t0);
     }
-    Pipeline pipeline(std::move(mesh), std::move(layout), options);
+    // --integer (paper §8): round every arc's length on the relaxed result to a multiple of Q
+    // (one value per poly-chord), then optimize again with those lengths as constraints.
+    std::optional<IntegerSizes> integer;
+    double E_relaxed = 0;
+    std::optional<NodeOptResult> relaxed_result;
+    if (o.integer) {
+      std::shared_ptr<Pipeline> relaxed;
+      if (node_result && node_result->pipeline && node_result->face_weights.empty())
+        relaxed = node_result->pipeline;
+      else
+        relaxed = std::make_shared<Pipeline>(mesh, layout, options);
+      if (!relaxed->parameterization()) relaxed->compute_parameterization();
+      E_relaxed = unweighted_energy(relaxed->mesh(), relaxed->geometry(), relaxed->field()->theta,
+                                    relaxed->parameterization()->corner_uv, options.param);
+      const double q = o.quad_size > 0 ? o.quad_size
+                                       : quad_size_for_count(relaxed->topology(),
+                                                             relaxed->extract(), o.quad_count);
+      integer = round_arc_lengths(relaxed->param_solver()->arc_lengths(), q);
+      if (!common.quiet)
+        std::cerr << "optimize: integer sizes with quad size " << q << ": "
+                  << integer->lengths.size() << " arc lengths rounded (largest change "
+                  << integer->max_change << "), relaxed E = " << E_relaxed << "\n";
+      PipelineOptions fixed = options;
+      fixed.param.arc_lengths = integer->lengths;
+      fixed.param.face_weights.clear();
+      fixed.param.orientation = PipelineOptions{}.param.orientation;
+      options = fixed;
+      if (!o.no_node_opt) {
+        t0 = std::chrono::steady_clock::now();
+        relaxed_result = std::move(node_result);
+        node_result.reset();
+        adopt(optimize(mesh, layout, options));
+        node_s += seconds_since(t0);
+      }
+    }
+    // The optimizer hands back its final Pipeline (solved with `options`, orientation
+    // constraints included when they were used); only stiffening weights need a new solve.
+    std::shared_ptr<Pipeline> solved;
+    if (node_result && node_result->pipeline && node_result->face_weights.empty())
+      solved = node_result->pipeline;
+    else
+      solved = std::make_shared<Pipeline>(std::move(mesh), std::move(layout), options);
+    Pipeline& pipeline = *solved;
     report["layout"] = layout_json(pipeline.topology());
     t0 = std::chrono::steady_clock::now();
-    const CrossField& field = pipeline.compute_field();
+    const CrossField& field = pipeline.field() ? *pipeline.field() : pipeline.compute_field();
     const double field_s = seconds_since(t0);
     t0 = std::chrono::steady_clock::now();
-    const Parameterization& param = pipeline.compute_parameterization();
+    const Parameterization& param = pipeline.parameterization()
+                                        ? *pipeline.parameterization()
+                                        : pipeline.compute_parameterization();
     const double param_s = seconds_since(t0);
     t0 = std::chrono::steady_clock::now();
     const Extraction& ex = pipeline.extract();
@@ -85,7 +148,10 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     const ParamMetrics m = pipeline.metrics();
     const double E_final = unweighted_energy(pipeline.mesh(), pipeline.geometry(), field.theta,
                                              param.corner_uv, options.param);
-    report["E_init"] = node_result ? node_result->E_init : E_final;
+    report["E_init"] = relaxed_result            ? relaxed_result->E_init
+                       : integer && !node_result ? E_relaxed
+                       : node_result             ? node_result->E_init
+                                                 : E_final;
     report["E_final"] = E_final;
     report["steps"] = nlohmann::json::array();
     if (node_result) {
@@ -100,15 +166,46 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
                                    {"phase", r.phase},
                                    {"moved_nodes", r.moved_nodes}});
       }
-      report["node_optimization"] = {{"method", o.discrete_relocation ? "discrete" : o.gradient},
-                                     {"steps", node_result->steps},
-                                     {"accepted", node_result->accepted},
-                                     {"halvings", node_result->halvings},
-                                     {"foldovers_init", node_result->foldovers_init},
-                                     {"foldovers_descent", node_result->foldovers_descent},
-                                     {"E_descent", node_result->E_descent},
-                                     {"stiffening_iterations", node_result->stiffening_iterations},
-                                     {"stiffened", !node_result->face_weights.empty()}};
+      report["node_optimization"] = {
+          {"method", o.discrete_relocation ? "discrete" : o.gradient},
+          {"steps", node_result->steps},
+          {"accepted", node_result->accepted},
+          {"halvings", node_result->halvings},
+          {"foldovers_init", node_result->foldovers_init},
+          {"foldovers_descent", node_result->foldovers_descent},
+          {"E_descent", node_result->E_descent},
+          {"stiffening_iterations", node_result->stiffening_iterations},
+          {"stiffened", !node_result->face_weights.empty()},
+          {"foldovers_before_orientation", node_result->foldovers_descent},
+          {"foldovers_final", node_result->foldovers_final},
+          {"fold_removal", node_result->orientation_constraints ? "orientation"
+                           : !node_result->face_weights.empty() ? "stiffening"
+                                                                : "none"},
+          {"orientation",
+           {{"ran", node_result->orientation.ran},
+            {"success", node_result->orientation.success},
+            {"constrained_faces", node_result->orientation.constrained_faces},
+            {"rounds", node_result->orientation.rounds},
+            {"iterations", node_result->orientation.iterations},
+            {"time_s", node_result->orientation.time_s},
+            {"message", node_result->orientation.message}}}};
+    }
+    if (integer) {
+      double worst = 0;  // largest deviation of a patch side from a multiple of Q (relative)
+      for (const auto& l : pipeline.param_solver()->arc_lengths()) {
+        const double k = l.length / integer->quad_size;
+        worst = std::max(worst, std::abs(k - std::round(k)));
+      }
+      report["integer"] = {{"quad_size", integer->quad_size},
+                           {"arcs", integer->lengths.size()},
+                           {"max_rounding_change", integer->max_change},
+                           {"min_multiple", integer->min_multiple},
+                           {"E_relaxed", E_relaxed},
+                           {"E_integer", E_final},
+                           {"max_deviation_from_integer", worst}};
+      if (relaxed_result)
+        report["integer"]["relaxed_node_optimization"] = {{"steps", relaxed_result->steps},
+                                                          {"E_final", relaxed_result->E_final}};
     }
     report["metrics"] = {{"E_confor", m.E_confor},
                          {"E_planar", m.E_planar},
@@ -130,8 +227,8 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     save_layout(pipeline.output_layout(), (out / "layout.json").string(), &pipeline.mesh());
     if (o.quad_size > 0 || o.quad_count > 0) {  // quad mesh export (issue #8)
       QuadMeshOptions qo;
-      qo.quad_size = o.quad_size;
-      qo.quad_count = o.quad_count;
+      qo.quad_size = integer ? integer->quad_size : o.quad_size;
+      qo.quad_count = integer ? 0 : o.quad_count;
       const QuadMesh quads = build_quad_mesh(pipeline, ex, qo);
       write_quad_exports(quads, pipeline.output_layout(), ex, out.string());
       report["quads"] = {{"quad_size", quads.quad_size},

@@ -24,10 +24,12 @@ struct OptimizeOptions {
   int steps = 25;
   bool no_node_opt = false;
   double quad_size = 0.0;
-  int quad_count = 0;  //!< alternative to quad_size: about this many quads
+  int quad_count = 0;    //!< alternative to quad_size: about this many quads
+  bool integer = false;  //!< patch sizes integer multiples of the quad size (paper §8)
   std::string gradient = "estimator";
   bool no_align = false;
   bool discrete_relocation = false;
+  bool no_orientation = false;  //!< no orientation constraints after the node optimization
   double sharp_angle_deg = 35.0;
   int threads = 2;
 };
@@ -36,6 +38,16 @@ struct ImportQuadsOptions {
   std::string quads, onto, out;
   bool all_edges = false;  //!< every quad edge is an arc (coarse cages)
   int refine = 1;          //!< split each quad refine x refine before triangulating
+  double coarsen = 0;      //!< collapse chords thinner than this many mean edge lengths (0: off)
+};
+
+struct CageLayoutOptions {
+  std::string mesh, out, cage;
+  int resolution = 12;     //!< voxel cells along the longest bounding-box axis
+  int attempts = 8;        //!< grids tried (resolution, shifted, resolution + 1, ...)
+  int smoothing = 30;      //!< spring relaxation rounds of the fitted cage (CageFitOptions)
+  bool all_edges = false;  //!< every cage edge is an arc (one patch per cage quad)
+  double coarsen = 1.5;    //!< collapse cage chords at most this many voxel cells wide (0: off)
 };
 
 struct PerturbOptions {
@@ -49,5 +61,6 @@ int run_field(const FieldOptions& options, const CommonOptions& common);
 int run_optimize(const OptimizeOptions& options, const CommonOptions& common);
 int run_import_quads(const ImportQuadsOptions& options, const CommonOptions& common);
 int run_perturb(const PerturbOptions& options, const CommonOptions& common);
+int run_cage_layout(const CageLayoutOptions& options, const CommonOptions& common);
 
 }  // namespace qs::cli

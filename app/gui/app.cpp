@@ -11,6 +11,7 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -215,7 +216,7 @@ bool App::init_window() {
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
   glfwWindowHint(GLFW_SCALE_TO_MONITOR, GLFW_TRUE);  // high-DPI: logical size in points
-  glfwWindowHint(GLFW_SAMPLES, 4);
+  glfwWindowHint(GLFW_SAMPLES, options_.msaa_samples < 0 ? 4 : options_.msaa_samples);
   window_ = glfwCreateWindow(options_.width, options_.height, "QuadSketch", nullptr, nullptr);
   if (!window_) {
     glfwWindowHint(GLFW_SAMPLES, 0);  // some software stacks refuse multisampling
@@ -223,8 +224,21 @@ bool App::init_window() {
   }
   if (!window_) return false;
   glfwMakeContextCurrent(window_);
+  if (options_.msaa_samples < 0) {
+    // Software rasterizers pay for every sample: start again without multisampling there.
+    const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    const std::string name = renderer ? renderer : "";
+    if (name.find("llvmpipe") != std::string::npos || name.find("softpipe") != std::string::npos ||
+        name.find("swrast") != std::string::npos) {
+      glfwDestroyWindow(window_);
+      glfwWindowHint(GLFW_SAMPLES, 0);
+      window_ = glfwCreateWindow(options_.width, options_.height, "QuadSketch", nullptr, nullptr);
+      if (!window_) return false;
+      glfwMakeContextCurrent(window_);
+    }
+  }
   // Automation measures frame times: do not wait for vertical sync there.
-  glfwSwapInterval(options_.frames > 0 ? 0 : 1);
+  glfwSwapInterval(options_.frames > 0 || options_.bench_frames > 0 ? 0 : 1);
   glfwSetWindowUserPointer(window_, this);
   // Installed before ImGui's backend, which chains to them (imgui 1.86).
   glfwSetKeyCallback(window_, key_callback);
@@ -261,6 +275,7 @@ void App::shutdown() {
     // GL objects must die while the context is current.
     mesh_layer_.reset();
     layout_layer_.reset();
+    field_layer_.reset();
     background_.reset();
     ImGui_ImplOpenGL3_Shutdown();
     ImGui_ImplGlfw_Shutdown();
@@ -278,6 +293,10 @@ bool App::job_layout_shown() const {
   return snapshot_ && snapshot_->mesh == doc_.mesh && snapshot_->iteration > 0 &&
          snapshot_->layout && snapshot_->status != WorkerStatus::Failed &&
          snapshot_->status != WorkerStatus::Idle;
+}
+
+void App::send_options() {
+  worker_->send(cmd::SetOptions{worker_options_});
 }
 
 void App::poll_worker() {
@@ -311,6 +330,8 @@ int App::run() {
     background_->init();
     mesh_layer_ = std::make_unique<render::MeshLayer>();
     layout_layer_ = std::make_unique<render::LayoutLayer>();
+    field_layer_ = std::make_unique<render::FieldLayer>();
+    field_layer_->visible = options_.show_field;
   } catch (const std::exception& e) {
     std::cerr << "quadsketch: " << e.what() << "\n";
     return 1;
@@ -320,10 +341,19 @@ int App::run() {
   camera_.set_viewport(win_w, win_h);
   reset_view();
   camera_.reset(true);
-  if (options_.run) {
+  // With a scripted stroke the run starts after the stroke (frame 2), so it runs on the edit.
+  const bool scripted_stroke = !options_.stroke_vertices.empty();
+  if (options_.run && !scripted_stroke) {
+    send_options();
     worker_->send(cmd::Run{});
     run_requested_ = true;
   }
+  // Benchmark: a few warm-up frames (shader compilation, first uploads), then N timed frames.
+  constexpr int kBenchWarmup = 10;
+  const int bench_total = options_.bench_frames > 0 ? kBenchWarmup + options_.bench_frames : 0;
+  std::vector<double> bench_ms;
+  bench_ms.reserve(std::size_t(std::max(0, options_.bench_frames)));
+  std::uint64_t bench_uploads = 0;
 
   double frame_seconds = 0.0;
   auto last = std::chrono::steady_clock::now();
@@ -339,10 +369,19 @@ int App::run() {
     last = frame_start;
     camera_.update(std::min(dt, 0.1f));
 
+    const std::uint64_t version_before = snapshot_version_;
     frame();
     render_scene(fb_w, fb_h);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     ++frame_count_;
+    if (scripted_stroke && frame_count_ == 2) {
+      apply_scripted_stroke();
+      if (options_.run) {
+        send_options();
+        worker_->send(cmd::Run{});
+        run_requested_ = true;
+      }
+    }
 
     // Automation: decide whether this frame is the one to save / the last one.
     if (run_requested_ && frames_since_run_done_ < 0 && snapshot_ &&
@@ -352,7 +391,9 @@ int App::run() {
     else if (frames_since_run_done_ >= 0)
       ++frames_since_run_done_;
     bool due = false;
-    if (options_.frames > 0) {
+    if (bench_total > 0) {
+      due = frame_count_ >= bench_total;
+    } else if (options_.frames > 0) {
       due = frame_count_ >= options_.frames;
     } else if (options_.run) {
       // Two more frames so that the final snapshot is uploaded and drawn.
@@ -370,9 +411,39 @@ int App::run() {
       options_.screenshot_path.clear();  // once
     }
     glfwSwapBuffers(window_);
+    if (bench_total > 0) {
+      glFinish();  // count the frame's GPU work too (llvmpipe renders on the CPU)
+      if (frame_count_ > kBenchWarmup) {
+        bench_ms.push_back(std::chrono::duration<double, std::milli>(
+                               std::chrono::steady_clock::now() - frame_start)
+                               .count());
+        if (snapshot_version_ != version_before) ++bench_uploads;
+      }
+    }
     frame_seconds +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - frame_start).count();
-    if (due && options_.quit) break;
+    if (due && (options_.quit || bench_total > 0)) break;
+  }
+  if (!bench_ms.empty()) {
+    std::vector<double> sorted = bench_ms;
+    std::sort(sorted.begin(), sorted.end());
+    double sum = 0.0;
+    for (double t : sorted) sum += t;
+    const double mean = sum / double(sorted.size());
+    const std::size_t k95 =
+        std::min(sorted.size() - 1, std::size_t(std::ceil(0.95 * double(sorted.size()))) - 1);
+    const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    GLint samples = 0;
+    glGetIntegerv(GL_SAMPLES, &samples);
+    std::printf(
+        "bench: %zu frames at %dx%d, mesh %zu faces, %zu nodes, %zu arcs; frame time mean %.2f "
+        "ms, p95 %.2f ms, max %.2f ms; %.1f fps (mean); %llu new snapshots shown; field "
+        "glyphs %s; %d MSAA samples; renderer: %s\n",
+        sorted.size(), fb_w, fb_h, doc_.mesh ? std::size_t(doc_.mesh->n_faces()) : std::size_t(0),
+        doc_.editor.layout().nodes.size(), doc_.editor.layout().arcs.size(), mean, sorted[k95],
+        sorted.back(), mean > 0.0 ? 1000.0 / mean : 0.0,
+        static_cast<unsigned long long>(bench_uploads),
+        field_layer_ && field_layer_->visible ? "on" : "off", samples, renderer ? renderer : "?");
   }
   if (options_.frames > 0 && frame_count_ > 0) {
     const double mean_ms = 1000.0 * frame_seconds / frame_count_;
@@ -477,7 +548,13 @@ void App::render_scene(int fb_width, int fb_height) {
   frame.framebuffer = {fb_width, fb_height};
   frame.pixel_ratio = float(fb_width) / std::max(1.0f, camera_.viewport().x);
   frame.time_s = glfwGetTime();
+  scene.stroke_points = stroke_points_;
+  if (snapshot_ && snapshot_->mesh == doc_.mesh && snapshot_->field) {
+    scene.field = snapshot_->field.get();
+    scene.field_version = snapshot_->version;
+  }
   for (render::Layer* layer : {static_cast<render::Layer*>(mesh_layer_.get()),
+                               static_cast<render::Layer*>(field_layer_.get()),
                                static_cast<render::Layer*>(layout_layer_.get())}) {
     layer->upload(scene);
     layer->draw(frame);

@@ -14,6 +14,7 @@
 #include "core/pipeline/worker.h"
 #include "render/background.h"
 #include "render/camera.h"
+#include "render/field_layer.h"
 #include "render/layout_layer.h"
 #include "render/mesh_layer.h"
 #include "render/picking.h"
@@ -30,11 +31,22 @@ struct AppOptions {
   std::string screenshot_path;
   int frames = 0;  //!< 0: not given
   bool quit = false;
+  //! Frame-time benchmark: render this many frames (after a short warm-up), print mean and
+  //! 95th-percentile frame time and fps, then quit. 0: off.
+  int bench_frames = 0;
+  bool show_field = false;  //!< start with the cross-field glyph layer on
+  //! Multisampling of the window; -1: automatic (4, or 0 on a software renderer such as
+  //! llvmpipe, where 4x multisampling costs about 4x the frame time).
+  int msaa_samples = -1;
+  //! Automation: a free-hand stroke through the screen positions of these mesh vertices
+  //! (the first must hold a node), applied like a mouse stroke with the stroke tool.
+  std::vector<int> stroke_vertices;
   int width = 1280;
   int height = 800;
 };
 
-enum class Tool { Select, PlaceNode, DrawArc, Split, Delete, Pin };
+enum class Tool { Select, PlaceNode, DrawArc, Split, Delete, Pin, Stroke, Dangling };
+constexpr int kToolCount = 8;
 
 class App {
  public:
@@ -57,7 +69,9 @@ class App {
   void poll_worker();
   //! True when the latest job snapshot (not the editor's layout) should be drawn.
   bool job_layout_shown() const;
-  bool automation() const { return !options_.screenshot_path.empty() || options_.quit; }
+  bool automation() const {
+    return !options_.screenshot_path.empty() || options_.quit || options_.bench_frames > 0;
+  }
 
   // Files (app.cpp).
   void open_mesh(const std::string& path);
@@ -91,6 +105,18 @@ class App {
   //! Sends SetPin / ClearPin for \p node to the worker and remembers it until applied.
   void toggle_live_pin(int node);
   void set_tool(Tool tool);
+  //! Stroke tool: starts a stroke at \p node, adds a mouse sample, ends it (the arc goes to
+  //! the node under \p mouse, or to a new node at the stroke's end).
+  void begin_stroke(int node, const glm::vec2& mouse);
+  void add_stroke_sample(const glm::vec2& mouse);
+  void end_stroke(const glm::vec2& mouse);
+  void cancel_stroke();
+  //! --stroke-vertices: the same stroke code driven by projected vertex positions.
+  void apply_scripted_stroke();
+  //! Dangling tool: the boundary vertex a click at the surface point \p hit would end on.
+  int dangling_target(const render::SurfaceHit& hit) const;
+  //! Sends the panel's pipeline options to the worker (before Run / Step start a job).
+  void send_options();
 
   // Panels (panels.cpp).
   void draw_ui();
@@ -101,6 +127,7 @@ class App {
   void draw_layout_section();
   void draw_validation_section();
   void draw_pipeline_section();
+  void draw_pipeline_options();
   void draw_history_controls();
   void draw_quads_section();
   void draw_metrics_panel();
@@ -125,6 +152,7 @@ class App {
   std::unique_ptr<render::Background> background_;
   std::unique_ptr<render::MeshLayer> mesh_layer_;
   std::unique_ptr<render::LayoutLayer> layout_layer_;
+  std::unique_ptr<render::FieldLayer> field_layer_;
   std::uint64_t picker_mesh_version_ = ~0ull;
 
   // Interaction state.
@@ -138,7 +166,12 @@ class App {
   std::vector<int> preview_path_;
   int preview_target_vertex_ = -1;
   std::uint64_t interaction_version_ = 0;
-  enum class Drag { None, Pending, Orbit, Pan, MoveNode } drag_ = Drag::None;
+  enum class Drag { None, Pending, Orbit, Pan, MoveNode, Stroke } drag_ = Drag::None;
+  // Free-hand stroke in progress: start node, samples on the surface, their 3D points.
+  int stroke_node_ = -1;
+  std::vector<SurfacePoint> stroke_samples_;
+  std::vector<glm::vec3> stroke_points_;
+  glm::vec2 stroke_last_mouse_{-1.0f};
   glm::vec2 press_pos_{0.0f};
   glm::vec2 last_mouse_{-1.0f};
   int press_node_ = -1;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "app/gui/app.h"
@@ -52,7 +53,7 @@ int App::pick_node(const glm::vec2& mouse, float radius_px) const {
     if (s.z > 1.0f) continue;
     const float d = glm::length(glm::vec2(s) - mouse);
     if (d > best_d) continue;
-    if (hit && glm::length(p - eye) > float(hit->distance) + slack) continue;
+    if (hit && glm::length(p - eye) > glm::length(glm::vec3(hit->position) - eye) + slack) continue;
     best_d = d;
     best = node.id;
   }
@@ -77,8 +78,8 @@ int App::pick_arc(const glm::vec2& mouse, float radius_px) const {
       const glm::vec2 cur(s);
       if (have_prev && s.z <= 1.0f) {
         const float d = distance_to_segment(mouse, prev, cur);
-        const bool visible =
-            !hit || glm::length(0.5f * (w + prev_world) - eye) <= float(hit->distance) + slack;
+        const bool visible = !hit || glm::length(0.5f * (w + prev_world) - eye) <=
+                                         glm::length(glm::vec3(hit->position) - eye) + slack;
         if (d < best_d && visible) {
           best_d = d;
           best = arc.id;
@@ -103,6 +104,21 @@ void App::update_hover(const glm::vec2& mouse) {
     ++interaction_version_;
   }
   hovered_vertex_ = vertex;
+  // Dangling tool: preview the route to the boundary vertex the click would end on.
+  if (tool_ == Tool::Dangling && arc_start_node_ >= 0) {
+    const auto& layout = doc_.editor.layout();
+    const int start = layout.node_index(arc_start_node_);
+    const int target = hit && start >= 0 && node != arc_start_node_ ? dangling_target(*hit) : -1;
+    if (start >= 0 && target != preview_target_vertex_) {
+      preview_target_vertex_ = target;
+      preview_path_.clear();
+      if (target >= 0) {
+        const RoutingObstacles obstacles = obstacles_of_layout(*doc_.mesh, layout);
+        preview_path_ = shortest_path(*doc_.mesh, layout.nodes[start].vertex, target, obstacles);
+      }
+      ++interaction_version_;
+    }
+  }
   // Arc tool: preview the route to the node (or vertex) under the cursor.
   if (tool_ == Tool::DrawArc && arc_start_node_ >= 0) {
     const auto& layout = doc_.editor.layout();
@@ -178,6 +194,44 @@ void App::click(const glm::vec2& mouse) {
       preview_target_vertex_ = -1;
       ++interaction_version_;
       break;
+    case Tool::Stroke:
+      status_ = node >= 0 ? "Drag from the node across the surface to draw the arc"
+                          : "Press on a node and drag across the surface (release on a node, or "
+                            "anywhere for a new end node)";
+      break;
+    case Tool::Dangling: {
+      if (arc_start_node_ < 0) {
+        if (node < 0) {
+          status_ = "Click a node to start a dangling arc (it ends on the mesh boundary)";
+          return;
+        }
+        arc_start_node_ = node;
+        preview_target_vertex_ = -1;
+        status_ = "Dangling arc from node " + std::to_string(node) +
+                  ": click near the boundary where it ends (the node again: nearest boundary)";
+      } else {
+        int target = -1;
+        if (node != arc_start_node_) {
+          const auto hit = pick_surface(mouse);
+          if (!hit) {
+            status_ = "Click on the surface near the boundary (Esc cancels)";
+            return;
+          }
+          target = dangling_target(*hit);
+          if (target < 0) {
+            status_ = "Not done: no free boundary vertex (closed mesh, or all taken)";
+            return;
+          }
+        }
+        const auto r = doc_.editor.add_dangling_arc(arc_start_node_, target);
+        apply(r, "Dangling arc " + std::to_string(r.id) + " added");
+        if (r) arc_start_node_ = -1;
+      }
+      preview_path_.clear();
+      preview_target_vertex_ = -1;
+      ++interaction_version_;
+      break;
+    }
     case Tool::Split: {
       if (arc < 0) {
         status_ = "Click on an arc to split it";
@@ -228,7 +282,8 @@ void App::handle_mouse() {
     if (ImGui::IsMouseClicked(ImGuiMouseButton_Left)) {
       press_pos_ = mouse;
       drag_ = Drag::Pending;
-      press_node_ = tool_ == Tool::Select ? pick_node(mouse, kNodePickPx) : -1;
+      press_node_ =
+          tool_ == Tool::Select || tool_ == Tool::Stroke ? pick_node(mouse, kNodePickPx) : -1;
     } else if (ImGui::IsMouseClicked(ImGuiMouseButton_Right) ||
                ImGui::IsMouseClicked(ImGuiMouseButton_Middle)) {
       drag_ = Drag::Pan;
@@ -245,7 +300,12 @@ void App::handle_mouse() {
         drag_ = Drag::None;
         click(mouse);
       } else if (glm::length(mouse - press_pos_) > kClickSlop) {
-        if (press_node_ >= 0 && doc_.editor.begin_drag(press_node_)) {
+        if (tool_ == Tool::Stroke && press_node_ >= 0) {
+          drag_ = Drag::Stroke;
+          begin_stroke(press_node_, press_pos_);
+          add_stroke_sample(mouse);
+        } else if (tool_ == Tool::Select && press_node_ >= 0 &&
+                   doc_.editor.begin_drag(press_node_)) {
           drag_ = Drag::MoveNode;
           selected_node_ = press_node_;
           selected_arc_ = -1;
@@ -270,6 +330,14 @@ void App::handle_mouse() {
         drag_ = Drag::None;
       } else {
         camera_.pan({io.MouseDelta.x, io.MouseDelta.y});
+      }
+      break;
+    case Drag::Stroke:
+      if (!ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
+        drag_ = Drag::None;
+        end_stroke(mouse);
+      } else if (mouse != last_mouse_) {
+        add_stroke_sample(mouse);
       }
       break;
     case Drag::MoveNode:
@@ -321,17 +389,108 @@ void App::handle_keys() {
         doc_.editor.cancel_drag();
         drag_ = Drag::None;
       }
+      if (drag_ == Drag::Stroke) {
+        cancel_stroke();
+        drag_ = Drag::None;
+        status_ = "Stroke cancelled";
+      }
       arc_start_node_ = -1;
       preview_path_.clear();
       selected_node_ = selected_arc_ = -1;
       ++interaction_version_;
-    } else if (key >= GLFW_KEY_1 && key <= GLFW_KEY_6) {
+    } else if (key >= GLFW_KEY_1 && key < GLFW_KEY_1 + kToolCount) {
       set_tool(static_cast<Tool>(key - GLFW_KEY_1));
     }
   }
 }
 
+void App::begin_stroke(int node, const glm::vec2& mouse) {
+  stroke_node_ = node;
+  stroke_samples_.clear();
+  stroke_points_.clear();
+  stroke_last_mouse_ = glm::vec2(-1e9f);
+  add_stroke_sample(mouse);
+  status_ = "Stroke from node " + std::to_string(node) + ": release on a node or anywhere";
+}
+
+void App::add_stroke_sample(const glm::vec2& mouse) {
+  if (stroke_node_ < 0) return;
+  if (glm::length(mouse - stroke_last_mouse_) < 2.0f) return;  // sub-pixel jitter
+  // Each sample is projected onto the surface; samples off the surface are skipped.
+  const auto hit = pick_surface(mouse);
+  if (!hit) return;
+  stroke_last_mouse_ = mouse;
+  SurfacePoint p;
+  p.face = hit->face;
+  p.bary = hit->bary;
+  stroke_samples_.push_back(p);
+  stroke_points_.emplace_back(hit->position);
+  ++interaction_version_;
+}
+
+void App::end_stroke(const glm::vec2& mouse) {
+  if (stroke_node_ < 0) return;
+  add_stroke_sample(mouse);
+  int to = pick_node(mouse, kNodePickPx);
+  if (to == stroke_node_ && stroke_samples_.size() < 3) to = -1;  // a click, not a loop
+  const auto r = doc_.editor.add_stroke_arc(stroke_node_, to, stroke_samples_);
+  if (r.ok && r.node_id >= 0)
+    apply(r, "Stroke arc " + std::to_string(r.id) + " to new node " + std::to_string(r.node_id));
+  else
+    apply(r, "Stroke arc " + std::to_string(r.id) + " added");
+  if (r) {
+    selected_arc_ = r.id;
+    selected_node_ = -1;
+  }
+  cancel_stroke();
+}
+
+void App::cancel_stroke() {
+  stroke_node_ = -1;
+  stroke_samples_.clear();
+  stroke_points_.clear();
+  ++interaction_version_;
+}
+
+void App::apply_scripted_stroke() {
+  const auto& vs = options_.stroke_vertices;
+  if (!doc_.mesh || vs.size() < 2) return;
+  std::vector<glm::vec2> screen;
+  for (int v : vs) {
+    if (v < 0 || v >= int(doc_.mesh->n_vertices())) {
+      report_error("--stroke-vertices: vertex " + std::to_string(v) + " out of range");
+      return;
+    }
+    screen.emplace_back(camera_.project(vertex_position(v)));
+  }
+  const int node = pick_node(screen.front(), kNodePickPx);
+  if (node < 0) {
+    report_error("--stroke-vertices: no visible node at vertex " + std::to_string(vs.front()));
+    return;
+  }
+  // Mouse-like samples every 3 pixels along the projected polyline.
+  begin_stroke(node, screen.front());
+  for (std::size_t k = 0; k + 1 < screen.size(); ++k) {
+    const int steps = std::max(1, int(glm::length(screen[k + 1] - screen[k]) / 3.0f));
+    for (int i = 1; i <= steps; ++i)
+      add_stroke_sample(glm::mix(screen[k], screen[k + 1], float(i) / float(steps)));
+  }
+  end_stroke(screen.back());
+  std::fprintf(stderr, "quadsketch: scripted stroke: %s\n", status_.c_str());
+}
+
+int App::dangling_target(const render::SurfaceHit& hit) const {
+  if (!doc_.mesh) return -1;
+  const RoutingObstacles obstacles = obstacles_of_layout(*doc_.mesh, doc_.editor.layout());
+  return nearest_boundary_vertex(*doc_.mesh, Vec3(hit.position.x, hit.position.y, hit.position.z),
+                                 &obstacles);
+}
+
 void App::set_tool(Tool tool) {
+  if (drag_ == Drag::Stroke) {
+    cancel_stroke();
+    drag_ = Drag::None;
+  }
   tool_ = tool;
   arc_start_node_ = -1;
   preview_path_.clear();

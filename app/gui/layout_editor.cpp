@@ -1,8 +1,12 @@
 #include "app/gui/layout_editor.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <utility>
 
+#include "core/base/errors.h"
+#include "core/layout/path_finder.h"
 #include "core/layout/routing.h"
 
 namespace qs::app {
@@ -27,7 +31,124 @@ bool valid_vertex(const TriMesh& mesh, int v) {
   return v >= 0 && v < int(mesh.n_vertices());
 }
 
+double distance_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  const double len2 = ab.sqrnorm();
+  const double t = len2 > 0.0 ? std::clamp(OpenMesh::dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
+  return (p - (a + t * ab)).norm();
+}
+
 }  // namespace
+
+Vec3 surface_position(const TriMesh& mesh, const SurfacePoint& p) {
+  Vec3 x(0, 0, 0);
+  int k = 0;
+  for (const auto vh : mesh.fv_range(OpenMesh::FaceHandle(p.face)))
+    if (k < 3) x += p.bary[k++] * mesh.point(vh);
+  return x;
+}
+
+int nearest_boundary_vertex(const TriMesh& mesh, const Vec3& point,
+                            const RoutingObstacles* obstacles) {
+  int best = -1;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (const auto vh : mesh.vertices()) {
+    if (!mesh.is_boundary(vh)) continue;
+    const int v = vh.idx();
+    if (obstacles && v < int(obstacles->vertex_blocked.size()) && obstacles->vertex_blocked[v])
+      continue;
+    const double d = (mesh.point(vh) - point).sqrnorm();
+    if (d < best_d) {
+      best_d = d;
+      best = v;
+    }
+  }
+  return best;
+}
+
+std::vector<int> route_stroke(const TriMesh& mesh, int source, int target,
+                              const std::vector<SurfacePoint>& stroke,
+                              const RoutingObstacles& obstacles, std::string* error,
+                              const StrokeOptions& options) {
+  auto fail = [&](std::string why) {
+    if (error) *error = std::move(why);
+    return std::vector<int>();
+  };
+  const int nv = int(mesh.n_vertices());
+  if (source < 0 || source >= nv || target >= nv) return fail("vertex out of range");
+  if (stroke.size() < 2) return fail("the stroke is too short (draw across the surface)");
+  // Samples in 3D (snap_to_vertex validates face index and barycentrics), and the local edge
+  // length h of the faces the stroke crosses.
+  std::vector<Vec3> points;
+  points.reserve(stroke.size());
+  double edge_sum = 0.0;
+  int edge_count = 0;
+  for (std::size_t k = 0; k < stroke.size(); ++k) {
+    try {
+      snap_to_vertex(mesh, stroke[k]);
+    } catch (const InvalidInputError& e) {
+      return fail("stroke sample " + std::to_string(k) + ": " + e.what());
+    }
+    points.push_back(surface_position(mesh, stroke[k]));
+    if (k == 0 || stroke[k].face != stroke[k - 1].face) {
+      for (const auto eh : mesh.fe_range(OpenMesh::FaceHandle(stroke[k].face))) {
+        edge_sum += mesh.calc_edge_length(eh);
+        ++edge_count;
+      }
+    }
+  }
+  const double h = edge_count > 0 ? edge_sum / edge_count : 0.0;
+  if (!(h > 0.0) || !std::isfinite(h)) return fail("the stroke crosses only degenerate faces");
+
+  if (target < 0) {
+    target = nearest_boundary_vertex(mesh, points.back(), &obstacles);
+    if (target < 0) {
+      const bool closed = nearest_boundary_vertex(mesh, points.back()) < 0;
+      return fail(closed ? "the mesh has no boundary to end a dangling arc on"
+                         : "every boundary vertex is already used by an arc or node");
+    }
+  }
+  if (target == source) return fail("the stroke starts and ends at the same vertex");
+
+  // Distance of every vertex to the stroke polyline; vertices outside the stroke's bounding
+  // box inflated by the corridor width get the box distance (a lower bound, enough there).
+  const double corridor = options.corridor_edges * h;
+  Vec3 lo = points[0], hi = points[0];
+  for (const Vec3& p : points) {
+    lo.minimize(p);
+    hi.maximize(p);
+  }
+  lo -= Vec3(corridor, corridor, corridor);
+  hi += Vec3(corridor, corridor, corridor);
+  std::vector<double> distance(nv, std::numeric_limits<double>::infinity());
+  for (int v = 0; v < nv; ++v) {
+    const Vec3& x = mesh.point(OpenMesh::VertexHandle(v));
+    bool inside = true;
+    for (int c = 0; c < 3; ++c) inside = inside && x[c] >= lo[c] && x[c] <= hi[c];
+    if (!inside) continue;
+    double d = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k + 1 < points.size(); ++k)
+      d = std::min(d, distance_to_segment(x, points[k], points[k + 1]));
+    distance[v] = d;
+  }
+  std::vector<double> cost(nv);
+  std::vector<char> allowed(nv, 0);
+  const double cap = 4.0 * options.corridor_edges;  // cost of vertices far from the stroke
+  for (int v = 0; v < nv; ++v) {
+    const double r = std::min(distance[v] / h, cap);
+    cost[v] = 1.0 + options.deviation_weight * r * r;
+    allowed[v] = distance[v] <= corridor;
+  }
+  allowed[source] = 1;
+  PathFinder finder(mesh);
+  std::vector<int> path = finder.find(source, target, obstacles, &allowed, &cost);
+  // Other arcs may close the corridor: then any free route, still drawn towards the stroke.
+  if (path.empty()) path = finder.find(source, target, obstacles, nullptr, &cost);
+  if (path.size() < 2)
+    return fail("no free path along the stroke from vertex " + std::to_string(source) +
+                " to vertex " + std::to_string(target) + " (other arcs are in the way)");
+  return path;
+}
 
 int next_node_id(const Layout& layout) {
   int id = 0;
@@ -142,7 +263,7 @@ EditResult LayoutEditor::add_node(int vertex) {
   layout_.nodes.push_back(node);
   layout_.patches.clear();
   commit("add node " + std::to_string(node.id), std::move(before));
-  return {true, {}, node.id};
+  return {true, {}, node.id, -1};
 }
 
 EditResult LayoutEditor::add_arc(int from_id, int to_id) {
@@ -167,7 +288,119 @@ EditResult LayoutEditor::add_arc(int from_id, int to_id) {
   layout_.patches.clear();
   const int id = layout_.arcs.back().id;
   commit("add arc " + std::to_string(id), std::move(before));
-  return {true, {}, id};
+  return {true, {}, id, -1};
+}
+
+EditResult LayoutEditor::add_stroke_arc(int from_id, int to_id,
+                                        const std::vector<SurfacePoint>& stroke,
+                                        const StrokeOptions& options) {
+  if (auto r = check_mesh(); !r) return r;
+  const int from = layout_.node_index(from_id);
+  if (from < 0) return EditResult::fail("the stroke must start at a node");
+  if (stroke.size() < 2) return EditResult::fail("the stroke is too short");
+  if (to_id >= 0 && layout_.node_index(to_id) < 0)
+    return EditResult::fail("unknown node " + std::to_string(to_id));
+  if (to_id < 0) {
+    // End at the vertex nearest to the last sample: an existing node there, else a new one.
+    int end_vertex = -1;
+    try {
+      end_vertex = snap_to_vertex(*mesh_, stroke.back());
+    } catch (const InvalidInputError& e) {
+      return EditResult::fail(std::string("the stroke's last sample is invalid: ") + e.what());
+    }
+    to_id = node_at_vertex(layout_, end_vertex);
+    if (to_id < 0) {
+      if (int arc = arc_through_vertex(layout_, end_vertex); arc >= 0)
+        return EditResult::fail("the stroke ends on arc " + std::to_string(arc) +
+                                " (end it at a node, or split the arc first)");
+      Layout before = layout_;
+      LayoutNode node;
+      node.id = next_node_id(layout_);
+      node.vertex = end_vertex;
+      Layout edited = layout_;
+      edited.nodes.push_back(node);
+      std::string error;
+      const RoutingObstacles obstacles = obstacles_of_layout(*mesh_, edited);
+      std::vector<int> path = route_stroke(*mesh_, layout_.nodes[from].vertex, end_vertex, stroke,
+                                           obstacles, &error, options);
+      if (path.empty()) return EditResult::fail(error);
+      LayoutArc arc;
+      arc.id = next_arc_id(edited);
+      arc.from = from_id;
+      arc.to = node.id;
+      arc.path = std::move(path);
+      edited.arcs.push_back(std::move(arc));
+      edited.patches.clear();
+      layout_ = std::move(edited);
+      const int id = layout_.arcs.back().id;
+      commit("stroke arc " + std::to_string(id) + " to new node " + std::to_string(node.id),
+             std::move(before));
+      return {true, {}, id, node.id};
+    }
+  }
+  if (to_id == from_id) return EditResult::fail("the stroke starts and ends at the same node");
+  const int to = layout_.node_index(to_id);
+  std::string error;
+  const RoutingObstacles obstacles = obstacles_of_layout(*mesh_, layout_);
+  std::vector<int> path = route_stroke(*mesh_, layout_.nodes[from].vertex, layout_.nodes[to].vertex,
+                                       stroke, obstacles, &error, options);
+  if (path.empty()) return EditResult::fail(error);
+  Layout before = layout_;
+  LayoutArc arc;
+  arc.id = next_arc_id(layout_);
+  arc.from = from_id;
+  arc.to = to_id;
+  arc.path = std::move(path);
+  layout_.arcs.push_back(std::move(arc));
+  layout_.patches.clear();
+  const int id = layout_.arcs.back().id;
+  commit("stroke arc " + std::to_string(id), std::move(before));
+  return {true, {}, id, -1};
+}
+
+EditResult LayoutEditor::add_dangling_arc(int from_id, int boundary_vertex) {
+  if (auto r = check_mesh(); !r) return r;
+  const int from = layout_.node_index(from_id);
+  if (from < 0) return EditResult::fail("unknown node " + std::to_string(from_id));
+  const int source = layout_.nodes[from].vertex;
+  if (!valid_vertex(*mesh_, source))
+    return EditResult::fail("node " + std::to_string(from_id) + " has no valid vertex");
+  if (nearest_boundary_vertex(*mesh_, Vec3(0, 0, 0)) < 0)
+    return EditResult::fail("the mesh has no boundary: dangling arcs end on the boundary");
+  const RoutingObstacles obstacles = obstacles_of_layout(*mesh_, layout_);
+  std::vector<int> path;
+  if (boundary_vertex < 0) {
+    path = shortest_path_to_boundary(*mesh_, source, obstacles);
+    if (path.size() < 2)
+      return EditResult::fail("no free path from node " + std::to_string(from_id) +
+                              " to the boundary (other arcs are in the way)");
+  } else {
+    if (!valid_vertex(*mesh_, boundary_vertex)) return EditResult::fail("vertex out of range");
+    if (!mesh_->is_boundary(OpenMesh::VertexHandle(boundary_vertex)))
+      return EditResult::fail("vertex " + std::to_string(boundary_vertex) +
+                              " is not on the mesh boundary");
+    if (boundary_vertex == source)
+      return EditResult::fail("node " + std::to_string(from_id) +
+                              " already sits on the boundary at that vertex");
+    if (obstacles.vertex_blocked[boundary_vertex])
+      return EditResult::fail("boundary vertex " + std::to_string(boundary_vertex) +
+                              " is already used by an arc or node");
+    path = shortest_path(*mesh_, source, boundary_vertex, obstacles);
+    if (path.size() < 2)
+      return EditResult::fail("no free path from node " + std::to_string(from_id) +
+                              " to boundary vertex " + std::to_string(boundary_vertex));
+  }
+  Layout before = layout_;
+  LayoutArc arc;
+  arc.id = next_arc_id(layout_);
+  arc.from = from_id;
+  arc.to = -1;
+  arc.path = std::move(path);
+  layout_.arcs.push_back(std::move(arc));
+  layout_.patches.clear();
+  const int id = layout_.arcs.back().id;
+  commit("dangling arc " + std::to_string(id), std::move(before));
+  return {true, {}, id, -1};
 }
 
 EditResult LayoutEditor::delete_node(int id) {
@@ -246,7 +479,7 @@ EditResult LayoutEditor::split_arc(int arc_id, int vertex) {
   layout_.arcs.push_back(std::move(second));
   layout_.patches.clear();
   commit("split arc " + std::to_string(arc_id), std::move(before));
-  return {true, {}, node.id};
+  return {true, {}, node.id, -1};
 }
 
 EditResult LayoutEditor::toggle_node_pin(int id) {

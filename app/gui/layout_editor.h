@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/layout/layout.h"
+#include "core/layout/routing.h"
 #include "core/mesh/mesh.h"
 
 namespace qs::app {
@@ -19,9 +20,39 @@ struct EditResult {
   bool ok = true;
   std::string error;  //!< why the edit was refused (ok == false)
   int id = -1;        //!< id of a created node/arc, when the edit creates one
-  static EditResult fail(std::string message) { return {false, std::move(message), -1}; }
+  int node_id = -1;   //!< id of a node created along with an arc (stroke to a new end node)
+  static EditResult fail(std::string message) { return {false, std::move(message), -1, -1}; }
   explicit operator bool() const { return ok; }
 };
+
+//! How a free-hand stroke becomes an edge path (route_stroke).
+struct StrokeOptions {
+  //! Vertices farther than this many local edge lengths from the stroke are used only when no
+  //! path exists inside that corridor (e.g. other arcs block it).
+  double corridor_edges = 4.0;
+  //! Cost factor of a vertex at distance d from the stroke: 1 + weight · (d / h)², h the mean
+  //! edge length of the faces the stroke crosses. Larger: the route hugs the stroke tighter.
+  double deviation_weight = 8.0;
+};
+
+//! Routes a free-hand stroke onto mesh edges: the edge path from vertex \p source to vertex
+//! \p target that minimizes length weighted by the distance to the stroke (StrokeOptions),
+//! avoiding \p obstacles (RoutingObstacles' rules; source and target may be blocked).
+//! \p stroke: surface points in drawing order (mouse samples projected onto the surface), at
+//! least 2. \p target = -1 ends the path on the unblocked boundary vertex nearest to the last
+//! stroke point (a dangling arc). Returns the vertex path (source first), or an empty path and
+//! a reason in \p error (bad samples, no boundary, no free path, source == target).
+std::vector<int> route_stroke(const TriMesh& mesh, int source, int target,
+                              const std::vector<SurfacePoint>& stroke,
+                              const RoutingObstacles& obstacles, std::string* error,
+                              const StrokeOptions& options = {});
+
+//! Unblocked boundary vertex nearest (Euclidean) to \p point, or -1 (closed mesh, all blocked).
+int nearest_boundary_vertex(const TriMesh& mesh, const Vec3& point,
+                            const RoutingObstacles* obstacles = nullptr);
+
+//! 3D position of a surface point (\pre valid face index and barycentrics).
+Vec3 surface_position(const TriMesh& mesh, const SurfacePoint& p);
 
 class LayoutEditor {
  public:
@@ -40,6 +71,18 @@ class LayoutEditor {
   //! New arc between two nodes, routed along the shortest free edge path (avoiding other
   //! arcs and nodes).
   EditResult add_arc(int from_id, int to_id);
+  //! New arc from node \p from_id following a free-hand \p stroke (route_stroke) to node
+  //! \p to_id. With \p to_id = -1 the arc ends at the vertex nearest to the stroke's last
+  //! point: at the node there if there is one, else at a new node created in the same undo
+  //! step (EditResult::node_id). EditResult::id is the new arc. Refused (nothing changes) for
+  //! strokes with fewer than 2 samples or invalid samples, ends on another arc, or no free route.
+  EditResult add_stroke_arc(int from_id, int to_id, const std::vector<SurfacePoint>& stroke,
+                            const StrokeOptions& options = {});
+  //! New dangling arc (LayoutArc::to = -1) from node \p from_id to the mesh boundary vertex
+  //! \p boundary_vertex, or with -1 to the nearest reachable free boundary vertex; routed along
+  //! the shortest free edge path. Refused on closed meshes, for vertices not on the boundary or
+  //! already used by an arc or node, and when no free path exists.
+  EditResult add_dangling_arc(int from_id, int boundary_vertex = -1);
   //! Deletes a node and every arc that ends at it.
   EditResult delete_node(int id);
   EditResult delete_arc(int id);

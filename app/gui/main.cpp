@@ -14,6 +14,19 @@ int main(int argc, char** argv) {
   cli.add_option("--frames", options.frames, "Number of frames before the screenshot / quit")
       ->check(CLI::PositiveNumber);
   cli.add_flag("--quit", options.quit, "Exit after the screenshot");
+  cli.add_option("--bench-frames", options.bench_frames,
+                 "Frame-time benchmark: render N frames (after 10 warm-up frames), print mean "
+                 "and 95th-percentile frame time and fps, and quit")
+      ->check(CLI::PositiveNumber);
+  cli.add_flag("--show-field", options.show_field, "Start with the cross-field glyph layer on");
+  cli.add_option("--samples", options.msaa_samples,
+                 "Multisampling (anti-aliasing) samples, 0: off (default: 4, or 0 on software "
+                 "renderers such as llvmpipe)")
+      ->check(CLI::Range(0, 16));
+  cli.add_option("--stroke-vertices", options.stroke_vertices,
+                 "Automation: draw a free-hand stroke (stroke tool) through the screen positions "
+                 "of these mesh vertices, comma-separated; the first must hold a node")
+      ->delimiter(',');
   cli.add_option("--width", options.width, "Window width")->check(CLI::Range(200, 8192));
   cli.add_option("--height", options.height, "Window height")->check(CLI::Range(200, 8192));
   CLI11_PARSE(cli, argc, argv);

@@ -61,6 +61,10 @@ const char* tool_name(Tool tool) {
       return "Delete";
     case Tool::Pin:
       return "Pin";
+    case Tool::Stroke:
+      return "Stroke arc";
+    case Tool::Dangling:
+      return "Dangling arc";
   }
   return "";
 }
@@ -79,6 +83,12 @@ const char* tool_hint(Tool tool) {
       return "Click a node (with its arcs) or an arc to delete it.";
     case Tool::Pin:
       return "Click a node or arc to pin / unpin it.";
+    case Tool::Stroke:
+      return "Press on a node and drag across the surface; release on a node, or anywhere for a "
+             "new end node. The arc follows mesh edges close to the stroke.";
+    case Tool::Dangling:
+      return "Click a node, then click near the mesh boundary: an arc from the node to the "
+             "boundary (trimmed patches). Click the node twice for the nearest boundary.";
   }
   return "";
 }
@@ -194,7 +204,7 @@ void App::draw_files_section() {
 
 void App::draw_tools_section() {
   if (!ImGui::CollapsingHeader("Sketch", ImGuiTreeNodeFlags_DefaultOpen)) return;
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kToolCount; ++i) {
     const Tool t = static_cast<Tool>(i);
     char label[64];
     std::snprintf(label, sizeof(label), "%d %s", i + 1, tool_name(t));
@@ -214,7 +224,7 @@ void App::draw_tools_section() {
     ImGui::TextColored(kDimColor, "last: %s", doc_.editor.undo_label().c_str());
   help_marker(
       "Mouse: left drag orbits, right/middle drag pans, wheel zooms.\n"
-      "Keys: 1-6 tools, F focus selection, R/Home reset view, Del delete, P pin, Esc cancel,\n"
+      "Keys: 1-8 tools, F focus selection, R/Home reset view, Del delete, P pin, Esc cancel,\n"
       "Ctrl+Z undo, Ctrl+Shift+Z / Ctrl+Y redo, Ctrl+S save.");
 }
 
@@ -312,14 +322,21 @@ void App::draw_pipeline_section() {
   if (!ImGui::CollapsingHeader("Pipeline", ImGuiTreeNodeFlags_DefaultOpen)) return;
   const bool has_mesh = doc_.mesh != nullptr;
   if (!has_mesh) ImGui::BeginDisabled();
-  if (ImGui::Button("Run")) worker_->send(cmd::Run{});
+  if (ImGui::Button("Run")) {
+    send_options();
+    worker_->send(cmd::Run{});
+  }
   ImGui::SameLine();
   if (ImGui::Button("Pause")) worker_->send(cmd::Pause{});
   ImGui::SameLine();
-  if (ImGui::Button("Step")) worker_->send(cmd::Step{});
+  if (ImGui::Button("Step")) {
+    send_options();
+    worker_->send(cmd::Step{});
+  }
   ImGui::SameLine();
   if (ImGui::Button("Stop")) worker_->send(cmd::Stop{});
   if (!has_mesh) ImGui::EndDisabled();
+  draw_pipeline_options();
   if (!snapshot_) return;
   const Snapshot& s = *snapshot_;
   const ImVec4 color = s.status == WorkerStatus::Failed     ? kErrorColor
@@ -352,6 +369,57 @@ void App::draw_pipeline_section() {
                      FLT_MAX,
                      ImVec2(ImGui::GetContentRegionAvail().x, 3.0f * ImGui::GetFontSize()));
   draw_history_controls();
+}
+
+void App::draw_pipeline_options() {
+  if (!ImGui::TreeNodeEx("Options", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  WorkerOptions& o = worker_options_;
+  ImGui::PushItemWidth(-7.5f * ImGui::GetFontSize());
+  bool no_align = !o.align;
+  if (ImGui::Checkbox("No alignment (--no-align)", &no_align)) o.align = !no_align;
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip(
+        "Ignore the principal curvature directions: the alignment-oblivious "
+        "baseline (features and the boundary still constrain the field)");
+  float sharp = float(o.sharp_angle_deg);
+  if (ImGui::SliderFloat("Sharp angle", &sharp, 1.0f, 180.0f, "%.0f\xc2\xb0"))
+    o.sharp_angle_deg = sharp;
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("Edges with a dihedral angle above this are features (--sharp-angle)");
+  float anisotropy = float(o.anisotropy);
+  if (ImGui::SliderFloat("Anisotropy", &anisotropy, 1.0f, 100.0f, "%.1f",
+                         ImGuiSliderFlags_Logarithmic))
+    o.anisotropy = anisotropy;
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("How much more misalignment costs than scale in energy (1) (1: isotropic)");
+  ImGui::Checkbox("Node optimization", &o.node_optimization);
+  if (!o.node_optimization) ImGui::BeginDisabled();
+  ImGui::SliderInt("Max steps", &o.max_steps, 1, 200, "%d", ImGuiSliderFlags_Logarithmic);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("Steps of a run, the initial solve included (--steps)");
+  float alpha = float(o.alpha);
+  if (ImGui::SliderFloat("alpha (damping)", &alpha, 0.05f, 1.0f, "%.2f")) o.alpha = alpha;
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("Initial damping factor of the node steps; halved after a rejected step");
+  if (!o.node_optimization) ImGui::EndDisabled();
+  ImGui::PopItemWidth();
+  // Clamp typed values (Ctrl+click) to what the pipeline accepts.
+  o.sharp_angle_deg = std::clamp(o.sharp_angle_deg, 1.0, 180.0);
+  o.anisotropy = std::clamp(o.anisotropy, 1.0, 1000.0);
+  o.max_steps = std::clamp(o.max_steps, 1, 10000);
+  o.alpha = std::clamp(o.alpha, 0.01, 1.0);
+  if (ImGui::Button("Defaults")) {
+    const WorkerOptions defaults;
+    o.align = defaults.align;
+    o.sharp_angle_deg = defaults.sharp_angle_deg;
+    o.anisotropy = defaults.anisotropy;
+    o.node_optimization = defaults.node_optimization;
+    o.max_steps = defaults.max_steps;
+    o.alpha = defaults.alpha;
+  }
+  ImGui::SameLine();
+  ImGui::TextDisabled("apply to the next Run / Step");
+  ImGui::TreePop();
 }
 
 void App::draw_history_controls() {
@@ -521,12 +589,17 @@ void App::draw_view_section() {
   ImGui::PushID("layout_layer");
   layout_layer_->ui();
   ImGui::PopID();
+  ImGui::Separator();
+  ImGui::PushID("field_layer");
+  field_layer_->ui();
+  ImGui::PopID();
   draw_legend();
 #ifndef NDEBUG
   if (ImGui::Button("Reload shaders")) {
     shader_log_.clear();
     mesh_layer_->reload(&shader_log_);
     layout_layer_->reload(&shader_log_);
+    field_layer_->reload(&shader_log_);
   }
   if (!shader_log_.empty()) ImGui::TextColored(kErrorColor, "%s", shader_log_.c_str());
   ImGui::SameLine();

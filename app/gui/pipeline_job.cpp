@@ -32,13 +32,20 @@ class CancelForwarder : public Observer {
 };
 
 struct JobState {
-  TriMesh mesh;   // current geometry (node relocation moves vertices on the surface)
-  Layout layout;  // current layout (node vertices, re-routed arcs)
+  TriMesh mesh;             // current geometry (node relocation moves vertices on the surface)
+  Layout layout;            // current layout (node vertices, re-routed arcs)
+  PipelineOptions options;  // fixed when the job starts (WorkerOptions of that moment)
   std::set<int> pinned_in_layout;  // nodes pinned in the editor's layout (stay pinned)
   double alpha = 0.75;
   int halvings = 0;
   double energy = 0;
   bool done = false;
+  //! Solved (field + parameterization with `options`) at exactly (mesh, layout), or null: the
+  //! display reuses it and the next node-optimization step starts from it (no re-solve).
+  std::shared_ptr<Pipeline> pipeline;
+  //! Solved with exactly `options` at (mesh, layout) (`pipeline` may hold the optimizer's
+  //! orientation-constrained solve instead): the next step's initial solve.
+  std::shared_ptr<Pipeline> warm;
 };
 
 // Node positions of \p layout on \p mesh: the traced position when known, else the vertex.
@@ -60,6 +67,32 @@ std::shared_ptr<const NodeFrame> node_frame(const TriMesh& mesh, const Layout& l
   return frame;
 }
 
+PipelineOptions pipeline_options(const WorkerOptions& o) {
+  PipelineOptions options;
+  options.field.constraints.curvature = o.align;
+  options.field.constraints.sharp_angle_deg = o.sharp_angle_deg;
+  options.param.anisotropy = o.anisotropy;
+  return options;
+}
+
+// The solved field for display: first direction per face and the constraints in force.
+std::shared_ptr<const FieldView> field_view(const Pipeline& pipeline) {
+  const CrossField* field = pipeline.field();
+  if (!field) return nullptr;
+  auto view = std::make_shared<FieldView>();
+  const std::vector<Vec3> dirs = field_directions(pipeline.geometry(), field->theta);
+  view->direction.reserve(dirs.size());
+  for (const Vec3& d : dirs) view->direction.push_back({float(d[0]), float(d[1]), float(d[2])});
+  const FieldConstraints& c = field->constraints;
+  for (std::size_t k = 0; k < c.face.size() && k < c.direction.size() && k < c.kind.size(); ++k) {
+    view->constraint_faces.push_back(c.face[k]);
+    view->constraint_direction.push_back(
+        {float(c.direction[k][0]), float(c.direction[k][1]), float(c.direction[k][2])});
+    view->constraint_kind.push_back(static_cast<char>(c.kind[k]));
+  }
+  return view;
+}
+
 std::shared_ptr<const QuadOverlay> overlay_of(const QuadMesh& quads) {
   auto overlay = std::make_shared<QuadOverlay>();
   overlay->quad_size = quads.quad_size;
@@ -73,22 +106,27 @@ std::shared_ptr<const QuadOverlay> overlay_of(const QuadMesh& quads) {
   return overlay;
 }
 
-// Solves field + parameterization + extraction for the job's current state and fills the
+// Solves field + parameterization (unless job.pipeline already holds them, e.g. handed back by
+// the node optimizer) + extraction for the job's current state and fills the
 // parts of a StepResult the UI draws (metrics, timings, node positions, exports; the quad mesh
 // when \p build_quads). Updates state.layout with the traced arcs.
 StepResult solve_for_display(JobState& job, WorkerState& state, const WorkerObserver& observer,
                              bool build_quads) {
   StepResult result;
   StepMetrics& m = result.metrics;
-  PipelineOptions options;
-  Pipeline pipeline(job.mesh, job.layout, options);
+  // The node optimizer hands back its solved Pipeline: solve only when there is none.
+  if (!job.pipeline || !job.pipeline->parameterization())
+    job.pipeline = std::make_shared<Pipeline>(job.mesh, job.layout, job.options);
+  Pipeline& pipeline = *job.pipeline;
   observer.check_cancel();
   auto t = Clock::now();
-  pipeline.compute_field();
+  if (!pipeline.field()) pipeline.compute_field();
   m.field_ms = ms_since(t);
+  result.field = field_view(pipeline);
   observer.check_cancel();
   t = Clock::now();
-  const Parameterization& param = pipeline.compute_parameterization();
+  const Parameterization& param = pipeline.parameterization() ? *pipeline.parameterization()
+                                                              : pipeline.compute_parameterization();
   m.param_ms = ms_since(t);
   observer.check_cancel();
   t = Clock::now();
@@ -166,6 +204,8 @@ StepResult pipeline_step(WorkerState& state, const WorkerObserver& observer) {
     job = std::make_shared<JobState>();
     job->mesh = *state.mesh;
     job->layout = state.layout;
+    job->options = pipeline_options(state.options);
+    job->alpha = state.options.alpha;
     for (const auto& node : job->layout.nodes)
       if (node.pinned) job->pinned_in_layout.insert(node.id);
     state.user = job;
@@ -181,13 +221,22 @@ StepResult pipeline_step(WorkerState& state, const WorkerObserver& observer) {
   CancelForwarder cancel(observer);
   NodeOptOptions options;
   options.max_steps = 1;
+  options.hop_polish = false;  // one step per call (a hop sweep would add more steps)
   options.alpha = job->alpha;
   options.stiffen_at_end = false;
   auto t = Clock::now();
+  // Warm start from the Pipeline of the previous display (optimize_nodes ignores it when the
+  // pins changed the layout), and display the Pipeline it returns: one solve per trial only.
+  // The optimizer may re-solve the start in place, so the job drops it until the step is done.
+  std::shared_ptr<Pipeline> warm_start = job->warm ? job->warm : job->pipeline;
+  job->pipeline.reset();
+  job->warm.reset();
   const NodeOptResult step =
-      optimize_nodes(job->mesh, job->layout, PipelineOptions{}, options, &cancel);
+      optimize_nodes(job->mesh, job->layout, job->options, options, &cancel, std::move(warm_start));
   const double nodeopt_ms = ms_since(t);
   const bool accepted = step.accepted > 0;
+  job->pipeline = step.pipeline;
+  job->warm = step.descent_pipeline;
   if (accepted) {
     job->mesh = step.mesh;
     job->layout = step.layout;

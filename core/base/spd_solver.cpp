@@ -1,7 +1,9 @@
 #include "core/base/spd_solver.h"
 
 #include <Eigen/CholmodSupport>
+#include <algorithm>
 #include <chrono>
+#include <vector>
 
 #include "core/base/errors.h"
 
@@ -17,6 +19,7 @@ struct SpdSolver::Impl {
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
   Eigen::Index rows = -1;
   Eigen::Index nnz = -1;
+  std::vector<int> outer, inner;  // pattern of the analyzed matrix (compressed)
   bool analyzed = false;
   bool factorized = false;
 };
@@ -36,6 +39,13 @@ void SpdSolver::analyze(const Eigen::SparseMatrix<double>& A) {
                       " unknowns)");
   impl_->rows = A.rows();
   impl_->nnz = A.nonZeros();
+  if (A.isCompressed()) {
+    impl_->outer.assign(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1);
+    impl_->inner.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
+  } else {
+    impl_->outer.clear();  // never matches: an uncompressed matrix is always re-analyzed
+    impl_->inner.clear();
+  }
   impl_->analyzed = true;
   impl_->factorized = false;
   stats_.analyze_s = seconds_since(t0);
@@ -43,7 +53,7 @@ void SpdSolver::analyze(const Eigen::SparseMatrix<double>& A) {
 }
 
 void SpdSolver::factorize(const Eigen::SparseMatrix<double>& A) {
-  if (!impl_->analyzed || A.rows() != impl_->rows || A.nonZeros() != impl_->nnz) analyze(A);
+  if (!same_pattern(A)) analyze(A);
   for (Eigen::Index k = 0; k < A.nonZeros(); ++k) {
     if (!std::isfinite(A.valuePtr()[k]))
       throw SolverError(stage_ + ": matrix has non-finite entries (" + std::to_string(A.rows()) +
@@ -82,6 +92,15 @@ Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& B) {
   if (impl_->llt.info() != Eigen::Success || !X.allFinite())
     throw SolverError(stage_ + ": solve produced non-finite values");
   return X;
+}
+
+bool SpdSolver::same_pattern(const Eigen::SparseMatrix<double>& A) const {
+  if (!impl_->analyzed || A.rows() != impl_->rows || A.cols() != impl_->rows ||
+      A.nonZeros() != impl_->nnz || !A.isCompressed() ||
+      impl_->outer.size() != static_cast<size_t>(A.outerSize()) + 1)
+    return false;
+  return std::equal(impl_->outer.begin(), impl_->outer.end(), A.outerIndexPtr()) &&
+         std::equal(impl_->inner.begin(), impl_->inner.end(), A.innerIndexPtr());
 }
 
 bool SpdSolver::factorized() const {

@@ -24,9 +24,13 @@ class SpdSolver {
 
   //! Symbolic analysis of the pattern of \p A (symmetric; the lower triangle is used).
   void analyze(const Eigen::SparseMatrix<double>& A);
-  //! Numeric factorization. Analyzes first if no pattern was analyzed or the size or the number
-  //! of non-zeros changed. \throw SolverError when A is not positive definite or not finite.
+  //! Numeric factorization. Analyzes first unless the last analysis was of exactly this
+  //! sparsity pattern (same size, same column starts and row indices; checked in O(nnz)), so a
+  //! solver handed on to a new system with an identical pattern keeps its analysis.
+  //! \throw SolverError when A is not positive definite or not finite.
   void factorize(const Eigen::SparseMatrix<double>& A);
+  //! True when the last analysis was of exactly the pattern of \p A (compressed storage).
+  bool same_pattern(const Eigen::SparseMatrix<double>& A) const;
   //! Solves A x = b with the last factorization. \throw SolverError on non-finite results.
   Eigen::VectorXd solve(const Eigen::VectorXd& b);
   Eigen::MatrixXd solve(const Eigen::MatrixXd& B);

@@ -140,7 +140,7 @@ class Transfer {
                            " away");
         continue;
       }
-      const int v = snap_node(cp, quads_.is_boundary(qv));
+      const int v = snap_node(cp, quads_.is_boundary(qv), complex_.valence[n]);
       if (v < 0) {
         stuck.push_back(n);
         continue;
@@ -165,7 +165,8 @@ class Transfer {
           "boundary node has no boundary vertex nearby); the target mesh is too coarse for "
           "this layout (" +
           std::to_string(n_nodes) + " nodes, " + std::to_string(complex_.arcs.size()) +
-          " arcs; the target mesh has " + std::to_string(target_.n_vertices()) + " vertices)");
+          " arcs; the target mesh has " + std::to_string(target_.n_vertices()) + " vertices)" +
+          coarsen_hint());
     }
     for (int n = 0; n < n_nodes; ++n) {
       LayoutNode node;
@@ -176,23 +177,36 @@ class Transfer {
     reserve_exits();
   }
 
-  // Nearest free vertex of the closest face, else of that face's 1-ring.
-  int snap_node(const ClosestPoint& cp, bool boundary) {
-    std::vector<int> candidates;
-    for (const auto v : target_.fv_range(OpenMesh::FaceHandle(cp.face))) {
-      candidates.push_back(v.idx());
-      for (const auto w : target_.vv_range(v)) candidates.push_back(w.idx());
-    }
-    std::sort(candidates.begin(), candidates.end());
-    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
-    std::stable_sort(candidates.begin(), candidates.end(), [&](int a, int b) {
-      return (target_.point(VH(a)) - cp.point).sqrnorm() <
-             (target_.point(VH(b)) - cp.point).sqrnorm();
-    });
-    for (int v : candidates) {
-      if (obstacles_.vertex_blocked[v]) continue;
-      if (boundary != target_.is_boundary(VH(v))) continue;
-      return v;
+  std::string coarsen_hint() const {
+    if (options_.coarsen > 0 || options_.all_edges) return "";
+    return "; --coarsen 3 collapses the layout's thin patch strips first";
+  }
+
+  // Nearest free vertex of the closest face, else of that face's 1-ring, with at least
+  // \p valence neighbours (the node's arcs need distinct exits).
+  int snap_node(const ClosestPoint& cp, bool boundary, int valence) {
+    // The closest face's vertices and their 1-ring first; farther rings (up to 3) only when
+    // none of them is free (dense layouts, boundary nodes on a coarse boundary).
+    std::vector<int> candidates, ring;
+    for (const auto v : target_.fv_range(OpenMesh::FaceHandle(cp.face))) ring.push_back(v.idx());
+    for (int rings = 1; rings <= 3; ++rings) {
+      std::vector<int> next = ring;
+      for (int v : ring)
+        for (const auto w : target_.vv_range(VH(v))) next.push_back(w.idx());
+      std::sort(next.begin(), next.end());
+      next.erase(std::unique(next.begin(), next.end()), next.end());
+      ring = next;
+      candidates = next;
+      std::stable_sort(candidates.begin(), candidates.end(), [&](int a, int b) {
+        return (target_.point(VH(a)) - cp.point).sqrnorm() <
+               (target_.point(VH(b)) - cp.point).sqrnorm();
+      });
+      for (int v : candidates) {
+        if (obstacles_.vertex_blocked[v]) continue;
+        if (boundary != target_.is_boundary(VH(v))) continue;
+        if (static_cast<int>(target_.valence(VH(v))) < valence) continue;
+        return v;
+      }
     }
     return -1;
   }
@@ -244,7 +258,8 @@ class Transfer {
     for (int n = 0; n < n_nodes; ++n) node_of_vertex[node_target_vertex_[n]] = n;
     std::vector<int> stuck;
     const double inf = std::numeric_limits<double>::infinity();
-    for (int n = 0; n < n_nodes; ++n) {
+    // Exits of node n at its current vertex; false when its free neighbours do not suffice.
+    auto assign = [&](int n) -> bool {
       const int t = node_target_vertex_[n];
       std::vector<int> ring;
       double reach = 0;
@@ -255,10 +270,9 @@ class Transfer {
       std::vector<int> halves = complex_.node_half_arcs[n];
       if (reversed_) std::reverse(halves.begin(), halves.end());
       const int k = static_cast<int>(halves.size()), m = static_cast<int>(ring.size());
-      if (k == 0) continue;
+      if (k == 0) return true;
       if (k > m) {
-        stuck.push_back(n);
-        continue;
+        return false;
       }
       reach /= m;
       std::vector<double> cost(k * m, inf);
@@ -311,8 +325,7 @@ class Transfer {
         }
       }
       if (!(best < inf)) {
-        stuck.push_back(n);
-        continue;
+        return false;
       }
       for (int i = 0; i < k; ++i) {
         const int w = best_choice[i];
@@ -322,12 +335,57 @@ class Transfer {
           obstacles_.vertex_blocked[w] = 1;
         }
       }
+      return true;
+    };
+    for (int n = 0; n < n_nodes; ++n) {
+      if (assign(n)) continue;
+      // Crowded: move the node to another free vertex nearby (if no arc end has claimed the
+      // edge to its vertex yet) and try again.
+      const int old = node_target_vertex_[n];
+      bool claimed = false;
+      for (int e : exit_) claimed = claimed || e == old;
+      bool placed = false;
+      if (!claimed) {
+        std::vector<int> near{old};
+        for (int rings = 0; rings < 2; ++rings) {
+          const size_t size = near.size();
+          for (size_t i = 0; i < size; ++i)
+            for (const auto w : target_.vv_range(VH(near[i]))) near.push_back(w.idx());
+        }
+        std::sort(near.begin(), near.end());
+        near.erase(std::unique(near.begin(), near.end()), near.end());
+        const Vec3 want = target_.point(VH(old));
+        std::stable_sort(near.begin(), near.end(), [&](int a, int b) {
+          return (target_.point(VH(a)) - want).sqrnorm() < (target_.point(VH(b)) - want).sqrnorm();
+        });
+        const bool boundary = target_.is_boundary(VH(old));
+        for (int c : near) {
+          if (c == old || obstacles_.vertex_blocked[c] || target_.is_boundary(VH(c)) != boundary)
+            continue;
+          node_of_vertex[old] = -1;
+          obstacles_.vertex_blocked[old] = 0;
+          node_target_vertex_[n] = c;
+          node_of_vertex[c] = n;
+          obstacles_.vertex_blocked[c] = 1;
+          if (assign(n)) {
+            placed = true;
+            break;
+          }
+          node_of_vertex[c] = -1;
+          obstacles_.vertex_blocked[c] = 0;
+          node_target_vertex_[n] = old;
+          node_of_vertex[old] = n;
+          obstacles_.vertex_blocked[old] = 1;
+        }
+      }
+      if (!placed) stuck.push_back(n);
     }
     if (!stuck.empty()) {
       throw InvalidInputError(
           "nodes " + join_ids(stuck) +
           " cannot keep their arcs in order on the target mesh: their target vertices have too "
-          "few free neighbours (the target mesh is too coarse for this layout near them)");
+          "few free neighbours (the target mesh is too coarse for this layout near them)" +
+          coarsen_hint());
     }
   }
 
@@ -378,7 +436,7 @@ class Transfer {
   bool is_boundary_arc(const QuadComplex::Arc& arc) const {
     for (size_t k = 0; k + 1 < arc.path.size(); ++k) {
       const HH h = quads_.find_halfedge(VH(arc.path[k]), VH(arc.path[k + 1]));
-      if (!quads_.is_boundary(quads_.edge_handle(h))) return false;
+      if (!h.is_valid() || !quads_.is_boundary(quads_.edge_handle(h))) return false;
     }
     return true;
   }
@@ -413,10 +471,23 @@ class Transfer {
       if (!boundary_only && target_.is_boundary(VH(v))) allowed_[v] = 0;
       const double x = curve_distance_[v] / mean_edge_;
       cost_[v] = 1.0 + 2.0 * x * x;
+      if (boundary_only && allowed_[v]) {
+        // A boundary arc runs along boundary edges only: no inner edge between two boundary
+        // vertices (it would cut off a corner of the surface).
+        for (const auto h : target_.voh_range(VH(v))) {
+          const int e = target_.edge_handle(h).idx();
+          if (target_.is_boundary(target_.edge_handle(h)) || obstacles_.edge_blocked[e]) continue;
+          if (!target_.is_boundary(target_.to_vertex_handle(h))) continue;
+          obstacles_.edge_blocked[e] = 1;
+          corridor_blocked_edges_.push_back(e);
+        }
+      }
     }
   }
 
   void clear_corridor() {
+    for (int e : corridor_blocked_edges_) obstacles_.edge_blocked[e] = 0;
+    corridor_blocked_edges_.clear();
     for (int v : corridor_) {
       allowed_[v] = 0;
       cost_[v] = 1.0;
@@ -453,21 +524,33 @@ class Transfer {
 
     std::vector<std::vector<int>> paths(n_arcs);
     std::vector<int> failed, far;
-    for (int a : order) {
-      const auto& arc = complex_.arcs[a];
-      double worst = 0;
-      const std::vector<Sample> samples = sample_arc(arc, worst);
-      if (worst > max_distance_) {
-        far.push_back(a);
-        continue;
+    // Arcs that could not be routed go first in the next attempt (at most 3 more), on a clean
+    // slate (node and exit reservations only).
+    const RoutingObstacles reserved = obstacles_;
+    std::vector<char> priority(n_arcs, 0);
+    for (int attempt = 0; attempt < 4; ++attempt) {
+      obstacles_ = reserved;
+      failed.clear();
+      far.clear();
+      std::stable_partition(order.begin(), order.end(), [&](int a) { return priority[a] != 0; });
+      for (int a : order) {
+        const auto& arc = complex_.arcs[a];
+        double worst = 0;
+        const std::vector<Sample> samples = sample_arc(arc, worst);
+        if (worst > max_distance_) {
+          far.push_back(a);
+          continue;
+        }
+        paths[a] = route_between_exits(a, samples, boundary[a] != 0);
+        clear_corridor();
+        if (paths[a].empty()) {
+          failed.push_back(a);
+          continue;
+        }
+        block_path(paths[a]);
       }
-      paths[a] = route_between_exits(a, samples, boundary[a] != 0);
-      clear_corridor();
-      if (paths[a].empty()) {
-        failed.push_back(a);
-        continue;
-      }
-      block_path(paths[a]);
+      if (failed.empty() || !far.empty()) break;
+      for (int a : failed) priority[a] = 1;
     }
     if (!far.empty()) {
       throw InvalidInputError("the quad mesh does not lie on the target mesh: arcs " +
@@ -479,7 +562,8 @@ class Transfer {
       throw InvalidInputError(
           "cannot route arcs " + join_ids(failed) +
           " onto the target mesh: no edge path near the source arc avoids the arcs routed "
-          "before (the target mesh may be too coarse for this layout)");
+          "before (the target mesh may be too coarse for this layout)" +
+          coarsen_hint());
     }
     for (int a = 0; a < n_arcs; ++a) {
       LayoutArc arc;
@@ -520,6 +604,7 @@ class Transfer {
   std::vector<double> cost_;
   std::vector<double> curve_distance_;
   std::vector<int> corridor_;
+  std::vector<int> corridor_blocked_edges_;  // inner edges blocked for a boundary arc
   std::vector<int> visit_stamp_;
   int stamp_ = 0;
   // Per half-arc: the target vertex next to its node through which it must leave (the other
@@ -666,14 +751,32 @@ QuadImportResult import_quads(const PolyMesh& quads, const TriMesh* target,
   BaseComplexOptions bc;
   bc.all_edges = options.all_edges;
   result.complex = base_complex(result.quads, bc);
+  const bool coarsen = options.coarsen > 0 && !options.all_edges;
   if (target) {
     if (options.refine != 1) {
       result.warnings.push_back("--refine is ignored when transferring onto another mesh");
     }
     result.mesh = *target;
-    result.layout = transfer_complex(result.quads, result.complex, *target, options);
   } else {
     result.mesh = triangulate_quads(result.quads, options.refine);
+  }
+  if (coarsen) {
+    CoarsenOptions co;
+    co.max_width =
+        options.coarsen * (target ? mesh_scales(*target).first : mesh_scales(result.quads).first);
+    result.complex = coarsen_complex(result.quads, result.complex, co, &result.coarsen);
+    if (!result.coarsen.skipped.empty())
+      result.warnings.push_back("the base complex was not coarsened: " + result.coarsen.skipped);
+  } else {
+    result.coarsen.nodes_before = result.coarsen.nodes_after =
+        static_cast<int>(result.complex.node_vertex.size());
+    result.coarsen.arcs_before = result.coarsen.arcs_after =
+        static_cast<int>(result.complex.arcs.size());
+    result.coarsen.patches_before = result.coarsen.patches_after = result.complex.num_patches;
+  }
+  if (target || !result.complex.simple_paths) {
+    result.layout = transfer_complex(result.quads, result.complex, result.mesh, options);
+  } else {
     result.layout = layout_on_triangulation(result.quads, result.complex, options.refine);
     result.layout.mesh_vertices = static_cast<int>(result.mesh.n_vertices());
     result.layout.mesh_faces = static_cast<int>(result.mesh.n_faces());

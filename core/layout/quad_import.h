@@ -26,14 +26,21 @@ struct QuadImportOptions {
   double corridor_radius = 2.5;
   //! With a target mesh: how often a failed arc is retried with the corridor radius doubled.
   int corridor_growths = 3;
+  //! > 0: coarsen the base complex first (coarsen_complex): collapse its poly-chords whose
+  //! crossed arcs are all at most coarsen × the mean edge length of the target mesh (without a
+  //! target: of the quad mesh). The coarsened layout is then routed onto the target, or onto
+  //! the triangulated quad mesh, like a transfer (without a target use refine >= 2 so the
+  //! routes have room). Ignored with all_edges.
+  double coarsen = 0;
 };
 
 struct QuadImportResult {
-  TriMesh mesh;         //!< the triangle mesh the layout lives on
-  Layout layout;        //!< node i / arc a have id i / a (QuadComplex order)
-  PolyMesh quads;       //!< the quad mesh used (after the split of non-quad faces, if any)
-  QuadComplex complex;  //!< the layout on \p quads
-  bool split = false;   //!< non-quad faces were split (split_to_quads)
+  TriMesh mesh;          //!< the triangle mesh the layout lives on
+  Layout layout;         //!< node i / arc a have id i / a (QuadComplex order)
+  PolyMesh quads;        //!< the quad mesh used (after the split of non-quad faces, if any)
+  QuadComplex complex;   //!< the layout on \p quads
+  bool split = false;    //!< non-quad faces were split (split_to_quads)
+  CoarsenStats coarsen;  //!< counts before/after coarsening (after == before without it)
   std::vector<std::string> warnings;
 };
 
@@ -56,11 +63,14 @@ Layout layout_on_triangulation(const PolyMesh& quads, const QuadComplex& complex
 
 //! Transfers the complex onto another triangle mesh \p target lying near the quad mesh:
 //! nodes go to the closest surface point of \p target, snapped to the nearest free vertex of
-//! its face (or of that face's 1-ring; boundary nodes only to boundary vertices); arcs are
+//! its face (or of that face's 1-ring, else up to 3 rings; boundary nodes only to boundary
+//! vertices; a node whose neighbours cannot take its arcs in order moves to a free vertex up to
+//! 2 rings away); arcs are
 //! routed along \p target's edges by a shortest path restricted to a corridor around the
 //! closest-point projection of the densely sampled source arc (cost grows with the distance
 //! from the projected curve), avoiding the arcs routed before (boundary arcs first, then by
-//! increasing length) and other nodes. The result must validate (validate_layout) and keep
+//! increasing length; arcs that fail go first in up to 3 more attempts) and other nodes;
+//! boundary arcs use boundary edges only. The result must validate (validate_layout) and keep
 //! every node's cyclic order of arcs.
 //! \throw InvalidInputError naming the nodes/arcs farther than
 //!        options.max_distance_fraction · bbox diagonal, nodes that find no free vertex, the
@@ -69,8 +79,9 @@ Layout transfer_complex(const PolyMesh& quads, const QuadComplex& complex, const
                         const QuadImportOptions& options = {});
 
 //! Whole import: splits non-quad faces once (with a warning), computes the base complex (or
-//! all edges), then builds the layout on the triangulated quad mesh (\p target == nullptr) or
-//! on \p target (transfer_complex).
+//! all edges), coarsens it (options.coarsen > 0), then builds the layout on the triangulated
+//! quad mesh (\p target == nullptr; exact, or routed like a transfer when coarsened) or on
+//! \p target (transfer_complex).
 //! \throw InvalidInputError as base_complex, triangulate_quads and transfer_complex.
 QuadImportResult import_quads(const PolyMesh& quads, const TriMesh* target,
                               const QuadImportOptions& options = {});

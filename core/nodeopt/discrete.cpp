@@ -1,5 +1,6 @@
 #include "core/nodeopt/discrete.h"
 
+#include <algorithm>
 #include <chrono>
 
 #include "core/nodeopt/gradient.h"
@@ -12,20 +13,85 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-struct Value {
-  double E = 0;
-  int foldovers = 0;
-};
-
-Value solve(const TriMesh& mesh, const Layout& layout, const PipelineOptions& options) {
-  Pipeline p(mesh, layout, options);
-  p.compute_field();
-  const Parameterization& r = p.compute_parameterization();
-  return {unweighted_energy(p.mesh(), p.geometry(), p.field()->theta, r.corner_uv, options.param),
-          r.foldovers};
+// Free neighbours of node n's vertex, in the order they are tried.
+std::vector<int> hop_candidates(const TriMesh& original, const Layout& layout, int n,
+                                const Vec3* direction, const HopSweepOptions& o) {
+  const int v = layout.nodes[n].vertex;
+  const std::vector<char> forbidden = forbidden_relocation_vertices(original, layout, n);
+  const auto vh = original.vertex_handle(v);
+  std::vector<std::pair<double, int>> ranked;  // (−cos, vertex), or (0, vertex) in ring order
+  for (auto wh : original.vv_range(vh)) {
+    if (forbidden[wh.idx()]) continue;
+    double key = 0;
+    if (direction) {
+      const Vec3 e = original.point(wh) - original.point(vh);
+      const double cos = (e | *direction) / (e.norm() * direction->norm());
+      if (cos < o.min_direction_cos) continue;
+      key = -cos;
+    }
+    ranked.push_back({key, wh.idx()});
+  }
+  std::stable_sort(ranked.begin(), ranked.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<int> out;
+  for (const auto& [key, w] : ranked) {
+    if (o.max_candidates > 0 && static_cast<int>(out.size()) >= o.max_candidates) break;
+    out.push_back(w);
+  }
+  return out;
 }
 
 }  // namespace
+
+HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
+                         const std::vector<int>& nodes, const std::vector<Vec3>& directions,
+                         double E, int foldovers, const HopSweepOptions& o,
+                         const HopEvaluator& evaluate, Observer* observer,
+                         const RerouteContext* context) {
+  HopSweepResult result;
+  result.E = E;
+  result.foldovers = foldovers;
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    const int n = nodes[i];
+    const Vec3* direction = directions.empty() ? nullptr : &directions[i];
+    if (direction && direction->norm() <= 0) continue;
+    const int v = layout.nodes[n].vertex;
+    const Vec3 restored = original.point(original.vertex_handle(v));
+    Layout best_layout;
+    int best_vertex = -1;
+    double best_E = result.E;
+    int best_foldovers = result.foldovers;
+    for (int w : hop_candidates(original, layout, n, direction, o)) {
+      if (result.evaluations >= o.max_evaluations) break;
+      const Vec3 at = mesh.point(mesh.vertex_handle(w));
+      if (!relocation_keeps_orientation(mesh, original, v, w, at, o.relocation)) continue;
+      Layout trial = layout;
+      if (!move_node_and_reroute(mesh, trial, n, w, o.relocation, context)) continue;
+      check_cancel(observer);
+      TriMesh moved = mesh;
+      moved.set_point(moved.vertex_handle(v), restored);
+      ++result.evaluations;
+      double trial_E = 0;
+      int trial_foldovers = 0;
+      if (!evaluate(moved, trial, trial_E, trial_foldovers)) continue;
+      if (trial_E < best_E) {
+        best_E = trial_E;
+        best_foldovers = trial_foldovers;
+        best_layout = std::move(trial);
+        best_vertex = w;
+      }
+    }
+    if (best_vertex >= 0) {
+      layout = std::move(best_layout);
+      mesh.set_point(mesh.vertex_handle(v), restored);
+      result.E = best_E;
+      result.foldovers = best_foldovers;
+      ++result.moved;
+    }
+    if (result.evaluations >= o.max_evaluations) break;
+  }
+  return result;
+}
 
 NodeOptResult relocate_nodes_discrete(const TriMesh& mesh, const Layout& layout,
                                       const PipelineOptions& options, const DiscreteOptions& d,
@@ -34,55 +100,52 @@ NodeOptResult relocate_nodes_discrete(const TriMesh& mesh, const Layout& layout,
   NodeOptResult result;
   result.mesh = mesh;
   result.layout = layout;
+  const HopEvaluator evaluate = [&](const TriMesh& m, const Layout& l, double& E, int& folds) {
+    try {
+      Pipeline p(m, l, options);
+      p.compute_field();
+      const Parameterization& r = p.compute_parameterization();
+      E = unweighted_energy(p.mesh(), p.geometry(), p.field()->theta, r.corner_uv, options.param);
+      folds = r.foldovers;
+      return true;
+    } catch (const Cancelled&) {
+      throw;
+    } catch (const QsError&) {
+      return false;
+    }
+  };
   check_cancel(observer);
-  Value current = solve(mesh, layout, options);
-  result.E_init = current.E;
-  result.foldovers_init = current.foldovers;
+  double E = 0;
+  int foldovers = 0;
+  {  // The initial solve must succeed: its errors are the caller's.
+    Pipeline p(mesh, layout, options);
+    p.compute_field();
+    const Parameterization& r = p.compute_parameterization();
+    E = unweighted_energy(p.mesh(), p.geometry(), p.field()->theta, r.corner_uv, options.param);
+    foldovers = r.foldovers;
+  }
+  result.E_init = E;
+  result.foldovers_init = foldovers;
   const std::vector<int> movable = movable_nodes(mesh, layout);
+  HopSweepOptions sweep;
+  sweep.relocation = d.relocation;
   int evaluations = 0;
   for (int step = 1; step <= d.max_steps && evaluations < d.max_evaluations; ++step) {
     const auto t_step = std::chrono::steady_clock::now();
-    int moved = 0;
-    for (int n : movable) {
-      const int v = result.layout.nodes[n].vertex;
-      const auto forbidden = forbidden_relocation_vertices(mesh, result.layout, n);
-      Layout best_layout;
-      Value best = current;
-      bool found = false;
-      for (auto wh : mesh.vv_range(mesh.vertex_handle(v))) {
-        if (forbidden[wh.idx()] || evaluations >= d.max_evaluations) continue;
-        check_cancel(observer);
-        Layout trial = result.layout;
-        if (!move_node_and_reroute(mesh, trial, n, wh.idx(), d.relocation)) continue;
-        ++evaluations;
-        Value val;
-        try {
-          val = solve(mesh, trial, options);
-        } catch (const Cancelled&) {
-          throw;
-        } catch (const QsError&) {
-          continue;
-        }
-        if (val.E < best.E) {
-          best = val;
-          best_layout = std::move(trial);
-          found = true;
-        }
-      }
-      if (found) {
-        result.layout = std::move(best_layout);
-        current = best;
-        ++moved;
-      }
-    }
+    sweep.max_evaluations = d.max_evaluations - evaluations;
+    const HopSweepResult s = hop_sweep(mesh, result.mesh, result.layout, movable, {}, E, foldovers,
+                                       sweep, evaluate, observer);
+    evaluations += s.evaluations;
+    E = s.E;
+    foldovers = s.foldovers;
     ++result.steps;
     StepReport r;
     r.step = step;
-    r.E = current.E;
-    r.accepted = moved > 0;
+    r.E = E;
+    r.accepted = s.moved > 0;
     r.step_size = 1;
-    r.foldovers = current.foldovers;
-    r.moved_nodes = moved;
+    r.foldovers = foldovers;
+    r.moved_nodes = s.moved;
     r.time_s = seconds_since(t_step);
     r.phase = "discrete";
     for (const auto& node : result.layout.nodes) {
@@ -91,11 +154,11 @@ NodeOptResult relocate_nodes_discrete(const TriMesh& mesh, const Layout& layout,
     }
     result.reports.push_back(r);
     if (observer) observer->on_step(r);
-    if (moved == 0) break;
+    if (s.moved == 0) break;
     ++result.accepted;
   }
-  result.E_descent = result.E_final = current.E;
-  result.foldovers_descent = result.foldovers_final = current.foldovers;
+  result.E_descent = result.E_final = E;
+  result.foldovers_descent = result.foldovers_final = foldovers;
   result.time_s = seconds_since(t_start);
   return result;
 }

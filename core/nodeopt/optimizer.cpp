@@ -5,6 +5,7 @@
 #include <cmath>
 #include <memory>
 
+#include "core/nodeopt/discrete.h"
 #include "core/nodeopt/geodesic.h"
 
 namespace qs {
@@ -15,21 +16,61 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// One solve of field + parameterization. The Pipeline is shared: a later trial without node
+// switches re-solves it in place (then it no longer holds this evaluation's solution).
 struct Evaluation {
-  std::unique_ptr<Pipeline> pipeline;
+  std::shared_ptr<Pipeline> pipeline;
   double E = 0;
   int foldovers = 0;
 };
 
-Evaluation evaluate(const TriMesh& mesh, const Layout& layout, const PipelineOptions& options) {
-  Evaluation ev;
-  ev.pipeline = std::make_unique<Pipeline>(mesh, layout, options);
+void solve_and_measure(Evaluation& ev, const PipelineOptions& options) {
   ev.pipeline->compute_field();
   const Parameterization& r = ev.pipeline->compute_parameterization();
   ev.E = unweighted_energy(ev.pipeline->mesh(), ev.pipeline->geometry(),
                            ev.pipeline->field()->theta, r.corner_uv, options.param);
   ev.foldovers = r.foldovers;
+}
+
+Evaluation evaluate_fresh(const TriMesh& mesh, const Layout& layout, const PipelineOptions& options,
+                          bool validate) {
+  Evaluation ev;
+  ev.pipeline = std::make_shared<Pipeline>(mesh, layout, options, validate);
+  solve_and_measure(ev, options);
   return ev;
+}
+
+// Same layout, moved vertices: update the geometry of \p pipeline and re-solve.
+Evaluation evaluate_reused(std::shared_ptr<Pipeline> pipeline, const TriMesh& mesh,
+                           const PipelineOptions& options) {
+  Evaluation ev;
+  ev.pipeline = std::move(pipeline);
+  ev.pipeline->update_positions(mesh);
+  solve_and_measure(ev, options);
+  return ev;
+}
+
+// True when \p p was built for exactly this mesh (positions) and layout (what the solves use).
+bool pipeline_matches(const Pipeline& p, const TriMesh& mesh, const Layout& layout) {
+  if (!p.parameterization() || !p.field()) return false;
+  const TriMesh& m = p.mesh();
+  if (m.n_vertices() != mesh.n_vertices() || m.n_faces() != mesh.n_faces()) return false;
+  for (auto v : mesh.vertices())
+    if (m.point(v) != mesh.point(v)) return false;
+  const Layout& l = p.layout();
+  if (l.nodes.size() != layout.nodes.size() || l.arcs.size() != layout.arcs.size() ||
+      l.feature_edges != layout.feature_edges)
+    return false;
+  for (size_t n = 0; n < l.nodes.size(); ++n)
+    if (l.nodes[n].id != layout.nodes[n].id || l.nodes[n].vertex != layout.nodes[n].vertex ||
+        l.nodes[n].pinned != layout.nodes[n].pinned)
+      return false;
+  for (size_t a = 0; a < l.arcs.size(); ++a)
+    if (l.arcs[a].id != layout.arcs[a].id || l.arcs[a].from != layout.arcs[a].from ||
+        l.arcs[a].to != layout.arcs[a].to || l.arcs[a].pinned != layout.arcs[a].pinned ||
+        l.arcs[a].path != layout.arcs[a].path)
+      return false;
+  return true;
 }
 
 struct State {
@@ -67,17 +108,35 @@ std::vector<int> movable_nodes(const TriMesh& mesh, const Layout& layout) {
 
 NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
                              const PipelineOptions& options, const NodeOptOptions& no,
-                             Observer* observer) {
+                             Observer* observer, std::shared_ptr<Pipeline> start,
+                             NodeOptStats* stats) {
   const auto t_start = std::chrono::steady_clock::now();
   const TriMesh& original = mesh;
   NodeOptResult result;
+  NodeOptStats counters;
   State state{mesh, layout, {}};
   for (const auto& n : layout.nodes) state.anchor.push_back(vertex_surface_point(mesh, n.vertex));
   const std::vector<int> movable = movable_nodes(mesh, layout);
   const double mean_edge = build_geometry(mesh).mean_edge_length;
 
   check_cancel(observer);
-  Evaluation current = evaluate(state.mesh, state.layout, options);
+  Evaluation current;
+  if (start && pipeline_matches(*start, mesh, layout)) {
+    current.pipeline = std::move(start);
+    current.E = unweighted_energy(current.pipeline->mesh(), current.pipeline->geometry(),
+                                  current.pipeline->field()->theta,
+                                  current.pipeline->parameterization()->corner_uv, options.param);
+    current.foldovers = current.pipeline->parameterization()->foldovers;
+    counters.warm_start = true;
+  } else {
+    current = evaluate_fresh(state.mesh, state.layout, options, true);
+    ++counters.fresh_pipelines;
+  }
+  // False when current.pipeline was re-solved for a rejected trial (it then holds the trial's
+  // positions, not state's).
+  bool current_solved = true;
+  // Re-routing keeps the patch count: computed once.
+  const RerouteContext reroute = make_reroute_context(mesh, layout);
   result.E_init = current.E;
   result.foldovers_init = current.foldovers;
   {
@@ -95,27 +154,128 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
   }
 
   double alpha = no.alpha;
-  while (result.steps < no.max_steps && result.halvings <= no.max_halvings && !movable.empty()) {
+  // Gradients and node-Voronoi cells depend on the state only: kept across rejected steps.
+  std::vector<Vec3> grad;
+  double scale = 1;
+  std::vector<int> cell;
+  bool state_changed = true;
+  // Descent phases: the first has max_steps steps; a hop sweep that moves nodes starts a new
+  // one (α reset) with at least hop_descent_steps more.
+  int step_budget = no.max_steps;
+  std::unique_ptr<State> pre_polish;  // the state before the first kept hop
+  int phase_halvings = 0;
+  // Hop sweep (discrete.h): nodes relocated far off their vertex try the neighbours in that
+  // direction. Returns true when a node hopped (state and current updated).
+  auto hop_round = [&]() {
+    const auto t_hop = std::chrono::steady_clock::now();
+    check_cancel(observer);
+    ++result.hop_rounds;
+    // The nodes relocated farthest off their vertex (the most strained) try first.
+    std::vector<std::pair<double, int>> strained;
+    for (int n : movable) {
+      const auto vh = original.vertex_handle(state.layout.nodes[n].vertex);
+      const double d = (state.mesh.point(vh) - original.point(vh)).norm();
+      if (d > 0 && d >= no.hop_min_offset * mean_edge) strained.push_back({-d, n});
+    }
+    std::sort(strained.begin(), strained.end());
+    std::vector<int> nodes;
+    std::vector<Vec3> directions;
+    for (const auto& [d, n] : strained) {  // directions: the relocation offsets
+      const auto vh = original.vertex_handle(state.layout.nodes[n].vertex);
+      nodes.push_back(n);
+      directions.push_back(state.mesh.point(vh) - original.point(vh));
+    }
+    HopSweepOptions sweep;
+    sweep.max_candidates = no.hop_candidates;
+    sweep.min_direction_cos = no.hop_min_cos;
+    sweep.max_evaluations = no.hop_max_evaluations;
+    sweep.relocation = no.relocation;
+    const HopEvaluator evaluate = [&](const TriMesh& m, const Layout& l, double& E, int& folds) {
+      try {
+        const Evaluation ev = evaluate_fresh(m, l, options, false);
+        ++counters.fresh_pipelines;
+        E = ev.E;
+        folds = ev.foldovers;
+        return true;
+      } catch (const Cancelled&) {
+        throw;
+      } catch (const QsError&) {
+        return false;
+      }
+    };
+    State hopped = state;
+    const HopSweepResult h =
+        hop_sweep(original, hopped.mesh, hopped.layout, nodes, directions, current.E,
+                  current.foldovers, sweep, evaluate, observer, &reroute);
+    bool kept = false;
+    if (h.moved > 0) {
+      for (int n : movable)
+        if (hopped.layout.nodes[n].vertex != state.layout.nodes[n].vertex)
+          hopped.anchor[n] = vertex_surface_point(original, hopped.layout.nodes[n].vertex);
+      check_cancel(observer);
+      Evaluation next = evaluate_fresh(hopped.mesh, hopped.layout, options, false);
+      ++counters.fresh_pipelines;
+      if (next.E <= current.E) {  // equal to h.E: the same deterministic solve
+        if (!pre_polish) pre_polish = std::make_unique<State>(state);
+        state = std::move(hopped);
+        current = std::move(next);
+        current_solved = true;
+        state_changed = true;
+        result.hops += h.moved;
+        kept = true;
+      }
+    }
+    StepReport r;
+    r.step = result.steps + result.hop_rounds;
+    r.E = current.E;
+    r.accepted = kept;
+    r.step_size = 0;
+    r.foldovers = current.foldovers;
+    r.moved_nodes = kept ? h.moved : 0;
+    r.time_s = seconds_since(t_hop);
+    r.phase = "hop";
+    r.node_positions = node_positions(state.mesh, state.layout);
+    result.reports.push_back(r);
+    if (observer) observer->on_step(r);
+    return kept;
+  };
+  // When a descent phase ends: a hop sweep; true when nodes hopped and a new phase begins.
+  auto polish = [&]() {
+    if (!no.hop_polish || result.hop_rounds >= no.max_hop_rounds || !hop_round()) return false;
+    alpha = no.alpha;
+    phase_halvings = 0;
+    step_budget = std::max(step_budget, result.steps + no.hop_descent_steps);
+    return true;
+  };
+  while (!movable.empty()) {
+    if (result.steps >= step_budget || phase_halvings > no.max_halvings) {
+      if (polish()) continue;
+      break;
+    }
     check_cancel(observer);
     const auto t_step = std::chrono::steady_clock::now();
-    // Gradients at the current solution.
-    std::vector<int> vertices;
-    for (int n : movable) vertices.push_back(state.layout.nodes[n].vertex);
-    std::vector<Vec3> grad;
-    double scale;
-    if (no.gradient == GradientMethod::Exact) {
-      grad = exact_node_gradients(state.mesh, state.layout, options, vertices, no.exact, observer);
-      scale = no.exact_scale;
+    if (state_changed) {
+      // Gradients at the current solution.
+      std::vector<int> vertices;
+      for (int n : movable) vertices.push_back(state.layout.nodes[n].vertex);
+      if (no.gradient == GradientMethod::Exact) {
+        grad =
+            exact_node_gradients(state.mesh, state.layout, options, vertices, no.exact, observer);
+        scale = no.exact_scale;
+      } else {
+        const Pipeline& p = *current.pipeline;
+        grad = estimate_node_gradients(p.mesh(), p.geometry(), p.field()->theta,
+                                       p.parameterization()->corner_uv, options.param, vertices);
+        scale = no.estimator_scale;
+      }
+      // Node-Voronoi cells on the original mesh, from all node vertices.
+      std::vector<int> all_vertices;
+      for (const auto& n : state.layout.nodes) all_vertices.push_back(n.vertex);
+      cell = node_voronoi_cells(original, all_vertices);
+      state_changed = false;
     } else {
-      const Pipeline& p = *current.pipeline;
-      grad = estimate_node_gradients(p.mesh(), p.geometry(), p.field()->theta,
-                                     p.parameterization()->corner_uv, options.param, vertices);
-      scale = no.estimator_scale;
+      ++counters.gradient_reuses;
     }
-    // Node-Voronoi cells on the original mesh, from all node vertices.
-    std::vector<int> all_vertices;
-    for (const auto& n : state.layout.nodes) all_vertices.push_back(n.vertex);
-    const std::vector<int> cell = node_voronoi_cells(original, all_vertices);
 
     // Builds the trial state; nodes with no_switch[i] set may only move within faces of their
     // current vertex's original 1-ring.
@@ -143,7 +303,8 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
                                                forbidden, no.relocation);
         if (w < 0) continue;
         if (w != v) {
-          if (!move_node_and_reroute(trial.mesh, trial.layout, n, w, no.relocation)) continue;
+          if (!move_node_and_reroute(trial.mesh, trial.layout, n, w, no.relocation, &reroute))
+            continue;
           trial.mesh.set_point(trial.mesh.vertex_handle(v),
                                original.point(original.vertex_handle(v)));
           switched[i] = 1;
@@ -154,10 +315,20 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
       }
       return moved;
     };
-    auto try_evaluate = [&](const State& trial, Evaluation& next) {
+    // A trial without switches has state's layout: re-solve the current Pipeline in place.
+    auto try_evaluate = [&](const State& trial, const std::vector<char>& switched,
+                            Evaluation& next) {
       check_cancel(observer);
+      const bool reuse = std::find(switched.begin(), switched.end(), 1) == switched.end();
       try {
-        next = evaluate(trial.mesh, trial.layout, options);
+        if (reuse) {
+          current_solved = false;
+          next = evaluate_reused(current.pipeline, trial.mesh, options);
+          ++counters.reused_solves;
+        } else {
+          next = evaluate_fresh(trial.mesh, trial.layout, options, false);
+          ++counters.fresh_pipelines;
+        }
         return true;
       } catch (const Cancelled&) {
         throw;
@@ -170,7 +341,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     int moved = build_trial(std::vector<char>(movable.size(), 0), trial, switched);
     ++result.steps;
     StepReport r;
-    r.step = result.steps;
+    r.step = result.steps + result.hop_rounds;
     r.step_size = alpha;
     r.moved_nodes = moved;
     r.phase = "descent";
@@ -182,19 +353,20 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
       r.node_positions = node_positions(state.mesh, state.layout);
       result.reports.push_back(r);
       if (observer) observer->on_step(r);
+      if (polish()) continue;
       break;
     }
     Evaluation next;
-    bool ok = try_evaluate(trial, next);
+    bool ok = try_evaluate(trial, switched, next);
     // A node that changed its vertex can raise E discontinuously: retry once with those nodes
     // kept on their vertices before halving α.
     if (no.retry_without_switches && !(ok && next.E <= current.E) &&
         std::find(switched.begin(), switched.end(), 1) != switched.end()) {
       State retry;
-      std::vector<char> unused;
-      if (build_trial(switched, retry, unused) > 0) {
+      std::vector<char> retry_switched;
+      if (build_trial(switched, retry, retry_switched) > 0) {
         Evaluation second;
-        if (try_evaluate(retry, second) && second.E <= current.E) {
+        if (try_evaluate(retry, retry_switched, second) && second.E <= current.E) {
           trial = std::move(retry);
           next = std::move(second);
           ok = true;
@@ -207,42 +379,126 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     if (r.accepted) {
       state = std::move(trial);
       current = std::move(next);
+      current_solved = true;
+      state_changed = true;
       ++result.accepted;
     } else {
       alpha *= 0.5;
       ++result.halvings;
+      ++phase_halvings;
     }
     r.time_s = seconds_since(t_step);
     r.node_positions = node_positions(state.mesh, state.layout);
     result.reports.push_back(r);
     if (observer) observer->on_step(r);
   }
-  result.E_descent = current.E;
-  result.foldovers_descent = current.foldovers;
-  result.E_final = current.E;
-  result.foldovers_final = current.foldovers;
-
-  if (no.stiffen_at_end && current.foldovers > 0) {
-    const auto t_st = std::chrono::steady_clock::now();
-    const StiffeningResult st = stiffen(state.mesh, state.layout, options, no.stiffening, observer);
-    result.stiffening_iterations = st.iterations;
-    if (st.foldovers_after < current.foldovers) {
-      result.face_weights = st.face_weights;
-      result.E_final = st.E_after;
-      result.foldovers_final = st.foldovers_after;
-    }
-    StepReport r;
-    r.step = result.steps + 1;
-    r.E = result.E_final;
-    r.accepted = !result.face_weights.empty();
-    r.step_size = 0;
-    r.foldovers = result.foldovers_final;
-    r.time_s = seconds_since(t_st);
-    r.phase = "stiffening";
-    r.node_positions = node_positions(state.mesh, state.layout);
-    result.reports.push_back(r);
-    if (observer) observer->on_step(r);
+  if (!current_solved) {  // the last trial re-solved the Pipeline in place and was rejected
+    check_cancel(observer);
+    current.pipeline->update_positions(state.mesh);
+    current.pipeline->compute_field();
+    current.pipeline->compute_parameterization();
+    ++counters.reused_solves;
   }
+  // The end of the descent at (state, current): fold-over removal, results into `out`.
+  auto finish = [&](const State& st_in, const Evaluation& ev, NodeOptResult& out) {
+    out.pipeline = ev.pipeline;
+    out.descent_pipeline = ev.pipeline;
+    out.E_descent = ev.E;
+    out.foldovers_descent = ev.foldovers;
+    out.E_final = ev.E;
+    out.foldovers_final = ev.foldovers;
+
+    // Fold-over removal: strict orientation constraints in the last solve (algorithm.md §7.2),
+    // stiffening (§7.1) only as the fallback when fold-overs remain.
+    if (no.orientation_at_end && ev.foldovers > 0) {
+      const auto t_or = std::chrono::steady_clock::now();
+      check_cancel(observer);
+      PipelineOptions oriented = options;
+      oriented.param.orientation = no.orientation;
+      oriented.param.orientation.enabled = true;
+      try {
+        auto p = std::make_shared<Pipeline>(st_in.mesh, st_in.layout, oriented);
+        p->compute_field();
+        const Parameterization& par = p->compute_parameterization();
+        out.orientation = par.orientation;
+        if (par.orientation.success && par.foldovers < ev.foldovers) {
+          out.orientation_constraints = true;
+          out.orientation_options = oriented.param.orientation;
+          out.E_final = unweighted_energy(p->mesh(), p->geometry(), p->field()->theta,
+                                          par.corner_uv, options.param);
+          out.foldovers_final = par.foldovers;
+          out.pipeline = std::move(p);
+        }
+      } catch (const Cancelled&) {
+        throw;
+      } catch (const QsError& e) {
+        out.orientation.message = e.what();
+      }
+      StepReport r;
+      r.step = result.steps + result.hop_rounds + 1;
+      r.E = out.E_final;
+      r.accepted = out.orientation_constraints;
+      r.foldovers = out.foldovers_final;
+      r.time_s = seconds_since(t_or);
+      r.phase = "orientation";
+      r.node_positions = node_positions(st_in.mesh, st_in.layout);
+      out.reports.push_back(r);
+      if (observer) observer->on_step(r);
+    }
+    if (no.stiffen_at_end && out.foldovers_final > 0) {
+      const auto t_st = std::chrono::steady_clock::now();
+      const StiffeningResult st =
+          stiffen(st_in.mesh, st_in.layout, options, no.stiffening, observer);
+      out.stiffening_iterations = st.iterations;
+      if (st.foldovers_after < out.foldovers_final) {
+        out.orientation_constraints = false;
+        out.pipeline = ev.pipeline;
+        out.face_weights = st.face_weights;
+        out.E_final = st.E_after;
+        out.foldovers_final = st.foldovers_after;
+      }
+      StepReport r;
+      r.step = result.steps + result.hop_rounds + 1;
+      r.E = out.E_final;
+      r.accepted = !out.face_weights.empty();
+      r.step_size = 0;
+      r.foldovers = out.foldovers_final;
+      r.time_s = seconds_since(t_st);
+      r.phase = "stiffening";
+      r.node_positions = node_positions(st_in.mesh, st_in.layout);
+      out.reports.push_back(r);
+      if (observer) observer->on_step(r);
+    }
+  };
+  finish(state, current, result);
+  // The polish (hops, and the descent after them) lowers E but can end where the fold-over
+  // removal fails although it succeeds at the state before the first hop: then that result is
+  // taken (fewer fold-overs; equal: lower final E).
+  if (result.foldovers_final > 0 && pre_polish) {
+    check_cancel(observer);
+    Evaluation ev = evaluate_fresh(pre_polish->mesh, pre_polish->layout, options, false);
+    ++counters.fresh_pipelines;
+    NodeOptResult alt;
+    finish(*pre_polish, ev, alt);
+    result.reports.insert(result.reports.end(), alt.reports.begin(), alt.reports.end());
+    if (alt.foldovers_final < result.foldovers_final ||
+        (alt.foldovers_final == result.foldovers_final && alt.E_final < result.E_final)) {
+      state = std::move(*pre_polish);
+      result.pipeline = alt.pipeline;
+      result.descent_pipeline = alt.descent_pipeline;
+      result.E_descent = alt.E_descent;
+      result.foldovers_descent = alt.foldovers_descent;
+      result.E_final = alt.E_final;
+      result.foldovers_final = alt.foldovers_final;
+      result.orientation_constraints = alt.orientation_constraints;
+      result.orientation_options = alt.orientation_options;
+      result.orientation = alt.orientation;
+      result.face_weights = alt.face_weights;
+      result.stiffening_iterations = alt.stiffening_iterations;
+      result.polish_reverted = true;
+    }
+  }
+  if (stats) *stats = counters;
   result.mesh = std::move(state.mesh);
   result.layout = std::move(state.layout);
   result.time_s = seconds_since(t_start);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <vector>
 
 #include "core/base/progress.h"
@@ -20,8 +21,10 @@ namespace qs {
 enum class GradientMethod { Estimator, Exact };
 
 struct NodeOptOptions {
-  int max_steps = 25;    //!< descent steps in total (accepted + rejected)
-  int max_halvings = 5;  //!< stop after this many halvings of α
+  //! Descent steps (accepted + rejected) before the first hop sweep; a sweep that moves nodes
+  //! extends the budget to at least hop_descent_steps more.
+  int max_steps = 25;
+  int max_halvings = 5;  //!< a descent phase ends after this many halvings of α
   double alpha = 0.75;   //!< damping factor α of the step length
   //! Step length l = α · scale · ‖d‖: ⅔ for the estimator, 1 for the exact gradient (paper §7.2).
   double estimator_scale = 2.0 / 3.0;
@@ -36,7 +39,33 @@ struct NodeOptOptions {
   //! When a step raises E and some nodes changed their vertex in it, retry the step once with
   //! those nodes kept on their vertices before halving α (the switch itself can raise E).
   bool retry_without_switches = true;
-  bool stiffen_at_end = true;  //!< stiffening (§7.1) when fold-overs remain after the descent
+  //! Polish by discrete hops (discrete.h hop_sweep) when the descent ends (no node moves, more
+  //! than max_halvings halvings, or the step budget is used up): the descent can stop in a local
+  //! optimum of E for the node carried by its current (relocated) vertex, which a hop to a
+  //! neighbouring vertex leaves. The nodes relocated farthest off their vertex try the
+  //! neighbours (at their original positions) in the direction of the relocation; hops that lower
+  //! E are kept (a step with phase "hop") and the descent resumes with α reset. Collective optima
+  //! (all nodes shifted together, e.g. a rotated cube layout on a sphere) are not left this way.
+  //! The first descent phase is the same with or without the polish, so it never ends higher.
+  //! Callers that drive the descent one step per call (max_steps = 1, the editor) turn it off:
+  //! a sweep extends the call by hop_descent_steps.
+  bool hop_polish = true;
+  int max_hop_rounds = 3;      //!< hop sweeps at most (each after a converged descent)
+  int hop_descent_steps = 10;  //!< descent steps available at least after a sweep with hops
+  //! Only nodes whose vertex is relocated at least this fraction of the mean edge length off
+  //! its original position try to hop.
+  double hop_min_offset = 0.25;
+  int hop_candidates = 2;    //!< neighbours tried per node (best aligned first)
+  double hop_min_cos = 0.0;  //!< only neighbours within 90° of the relocation direction
+  //! Candidate solves per sweep (work cap); the most strained nodes (largest relocation)
+  //! try first.
+  int hop_max_evaluations = 16;
+  //! Fold-over removal after the descent: a last solve with strict orientation constraints
+  //! (algorithm.md §7.2, core/param/orientation.h) when fold-overs remain; `enabled` inside
+  //! `orientation` is set by the optimizer (CLI: --no-orientation clears orientation_at_end).
+  bool orientation_at_end = true;
+  OrientationOptions orientation;
+  bool stiffen_at_end = true;  //!< stiffening (§7.1) when fold-overs remain after that
   StiffeningOptions stiffening;
 };
 
@@ -49,10 +78,38 @@ struct NodeOptResult {
   double E_descent = 0;  //!< residual after the descent, before stiffening
   double E_final = 0;    //!< residual of the final solve (after stiffening, if it ran)
   int foldovers_init = 0, foldovers_descent = 0, foldovers_final = 0;
-  int steps = 0, accepted = 0, halvings = 0;
+  int steps = 0, accepted = 0, halvings = 0;  //!< descent steps (hop sweeps not included)
+  int hop_rounds = 0;                         //!< hop sweeps run (NodeOptOptions::hop_polish)
+  int hops = 0;                               //!< node hops kept by those sweeps
+  //! Fold-overs remained after the fold-over removal at the polished state but fewer (or as
+  //! many at a lower E_final) at the state before the first hop: that state was returned
+  //! (E_descent is then its E, above the last accepted step's).
+  bool polish_reverted = false;
   int stiffening_iterations = 0;
-  std::vector<StepReport> reports;  //!< one per step (descent, then stiffening)
+  //! The final solve uses the orientation constraints: re-solving the final (mesh, layout)
+  //! needs ParamOptions::orientation.enabled (and `orientation_options`) to reproduce it;
+  //! `pipeline` then holds that constrained solve. foldovers_descent is the count before.
+  bool orientation_constraints = false;
+  OrientationOptions orientation_options;  //!< the options of that solve (enabled = true)
+  OrientationReport orientation;           //!< of the constrained solve (ran = false: none)
+  std::vector<StepReport> reports;         //!< one per step (descent, then stiffening)
   double time_s = 0;
+  //! The pipeline solved (field + parameterization, no stiffening weights) at the final
+  //! (mesh, layout) of the descent, for callers that display or extract it without solving
+  //! again. Its mesh is `mesh` and its layout is `layout`.
+  std::shared_ptr<Pipeline> pipeline;
+  //! The descent's own Pipeline at the final (mesh, layout), solved with exactly the given
+  //! PipelineOptions (the same object as `pipeline` unless the final orientation-constrained
+  //! solve replaced that): a valid `start` for a further optimize_nodes call.
+  std::shared_ptr<Pipeline> descent_pipeline;
+};
+
+//! Counters of the work done by optimize_nodes (for benchmarks and the reuse test).
+struct NodeOptStats {
+  int fresh_pipelines = 0;  //!< Pipelines built (a node changed its vertex, or the start)
+  int reused_solves = 0;    //!< re-solves of the previous Pipeline after vertices moved
+  int gradient_reuses = 0;  //!< steps after a rejection that reused the gradient
+  bool warm_start = false;  //!< the given start Pipeline served as the initial solve
 };
 
 //! Nodes that the optimizer may move: not pinned, not an end of a pinned arc, not on the mesh
@@ -62,9 +119,17 @@ std::vector<int> movable_nodes(const TriMesh& mesh, const Layout& layout);
 //! Runs the node optimization. The input mesh's positions are the "original" positions (each
 //! relocated vertex lies on the original surface; a vertex given up by a node gets its original
 //! position back). Every step is reported to \p observer, which is polled between solves.
+//! Steps in which no node changes its vertex re-solve the previous Pipeline in place (geometry
+//! updated, solver setup and factorization patterns kept); a step that re-routes arcs builds a
+//! new one (without re-validating: re-routing keeps the layout's structure).
+//! \p start, when given, is a Pipeline already solved (compute_parameterization) at exactly
+//! (\p mesh, \p layout) with \p options: it serves as the initial solve. \p stats, when given,
+//! receives work counters.
 //! \throw InvalidInputError (invalid layout), TopologyError, SolverError, Cancelled.
 NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
                              const PipelineOptions& options,
-                             const NodeOptOptions& node_options = {}, Observer* observer = nullptr);
+                             const NodeOptOptions& node_options = {}, Observer* observer = nullptr,
+                             std::shared_ptr<Pipeline> start = nullptr,
+                             NodeOptStats* stats = nullptr);
 
 }  // namespace qs

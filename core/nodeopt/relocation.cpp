@@ -110,21 +110,153 @@ bool same_layout_structure(const LayoutTopology& a, const LayoutTopology& b) {
   return true;
 }
 
+namespace {
+
+using HH = OpenMesh::HalfedgeHandle;
+
+// Outgoing halfedges of v in ccw order; for a boundary vertex the list starts right after the
+// exterior wedge (the order build_topology uses).
+std::vector<HH> outgoing_ccw(const TriMesh& mesh, OpenMesh::VertexHandle v) {
+  std::vector<HH> out;
+  const HH start = mesh.halfedge_handle(v);
+  if (!start.is_valid()) return out;
+  auto ccw_next = [&](HH h) { return mesh.opposite_halfedge_handle(mesh.prev_halfedge_handle(h)); };
+  HH boundary;
+  HH h = start;
+  do {
+    if (mesh.is_boundary(h)) boundary = h;
+    h = mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(h));
+  } while (h != start);
+  const HH first = boundary.is_valid() ? ccw_next(boundary) : start;
+  h = first;
+  do {
+    out.push_back(h);
+    h = ccw_next(h);
+  } while (h != first);
+  return out;
+}
+
+// Half-arcs at node n in counter-clockwise order (as LayoutTopology::node_half_arcs), from the
+// first edges of the arcs around the node's vertex only.
+std::vector<int> rotation_at(const TriMesh& mesh, const Layout& layout, int n) {
+  const int id = layout.nodes[n].id;
+  const int v = layout.nodes[n].vertex;
+  std::vector<std::pair<int, int>> firsts;  // (second vertex of the arc from v, half-arc)
+  for (int a = 0; a < static_cast<int>(layout.arcs.size()); ++a) {
+    const LayoutArc& arc = layout.arcs[a];
+    const auto& p = arc.path;
+    if (p.size() < 2) continue;
+    if (arc.from == id && p.front() == v) firsts.push_back({p[1], 2 * a});
+    if (!arc.dangling() && arc.to == id && p.back() == v)
+      firsts.push_back({p[p.size() - 2], 2 * a + 1});
+  }
+  std::vector<int> out;
+  for (HH h : outgoing_ccw(mesh, mesh.vertex_handle(v))) {
+    const int w = mesh.to_vertex_handle(h).idx();
+    for (const auto& [second, half] : firsts)
+      if (second == w) out.push_back(half);
+  }
+  return out;
+}
+
+}  // namespace
+
+int count_patches(const TriMesh& mesh, const Layout& layout) {
+  std::vector<char> wall(mesh.n_edges(), 0);
+  for (auto e : mesh.edges())
+    if (mesh.is_boundary(e)) wall[e.idx()] = 1;
+  for (const LayoutArc& arc : layout.arcs)
+    for (size_t k = 0; k + 1 < arc.path.size(); ++k) {
+      const HH h =
+          mesh.find_halfedge(mesh.vertex_handle(arc.path[k]), mesh.vertex_handle(arc.path[k + 1]));
+      if (h.is_valid()) wall[mesh.edge_handle(h).idx()] = 1;
+    }
+  std::vector<char> seen(mesh.n_faces(), 0);
+  std::vector<int> stack;
+  int patches = 0;
+  for (auto f0 : mesh.faces()) {
+    if (seen[f0.idx()]) continue;
+    ++patches;
+    seen[f0.idx()] = 1;
+    stack.assign(1, f0.idx());
+    while (!stack.empty()) {
+      const auto f = mesh.face_handle(stack.back());
+      stack.pop_back();
+      for (auto h : mesh.fh_range(f)) {
+        if (wall[mesh.edge_handle(h).idx()]) continue;
+        const int g = mesh.opposite_face_handle(h).idx();
+        if (!seen[g]) {
+          seen[g] = 1;
+          stack.push_back(g);
+        }
+      }
+    }
+  }
+  return patches;
+}
+
+RerouteContext make_reroute_context(const TriMesh& mesh, const Layout& layout) {
+  RerouteContext c;
+  c.patches = count_patches(mesh, layout);
+  bool closed = true;
+  for (auto e : mesh.edges()) closed = closed && !mesh.is_boundary(e);
+  const long chi = static_cast<long>(mesh.n_vertices()) - static_cast<long>(mesh.n_edges()) +
+                   static_cast<long>(mesh.n_faces());
+  // Connected: one component of faces across edges.
+  std::vector<char> seen(mesh.n_faces(), 0);
+  std::vector<int> stack{0};
+  size_t reached = mesh.n_faces() > 0 ? 1 : 0;
+  if (mesh.n_faces() > 0) seen[0] = 1;
+  while (!stack.empty()) {
+    const auto f = mesh.face_handle(stack.back());
+    stack.pop_back();
+    for (auto g : mesh.ff_range(f))
+      if (!seen[g.idx()]) {
+        seen[g.idx()] = 1;
+        ++reached;
+        stack.push_back(g.idx());
+      }
+  }
+  c.sphere = closed && chi == 2 && reached == mesh.n_faces();
+  return c;
+}
+
 bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, int new_vertex,
-                           const RelocationOptions& options) {
+                           const RelocationOptions& options, const RerouteContext* context) {
   const int old_vertex = layout.nodes[node_index].vertex;
   if (new_vertex == old_vertex) return true;
-  const LayoutTopology before = build_topology(mesh, layout);
   const int id = layout.nodes[node_index].id;
+  // The new vertex must be free: no other node, no arc that is not incident to the node.
+  for (int n = 0; n < static_cast<int>(layout.nodes.size()); ++n)
+    if (n != node_index && layout.nodes[n].vertex == new_vertex) return false;
+  for (const LayoutArc& arc : layout.arcs) {
+    if (arc.from == id || arc.to == id) continue;
+    if (std::find(arc.path.begin(), arc.path.end(), new_vertex) != arc.path.end()) return false;
+  }
+  const std::vector<int> rotation = rotation_at(mesh, layout, node_index);
   // Incident arcs, in the node's cyclic order (a loop arc appears twice: skip those).
   std::vector<int> incident;
-  for (int h : before.node_half_arcs[node_index]) {
+  for (int h : rotation) {
     const int a = LayoutTopology::arc_of(h);
     if (std::find(incident.begin(), incident.end(), a) != incident.end()) return false;
     incident.push_back(a);
   }
   for (int a : incident)
     if (layout.arcs[a].pinned) return false;
+  // Nodes whose first arc edges may change: this node and the far ends of its arcs.
+  std::vector<int> affected{node_index};
+  for (int a : incident) {
+    const LayoutArc& arc = layout.arcs[a];
+    if (arc.dangling()) continue;
+    const int other = layout.node_index(arc.from == id ? arc.to : arc.from);
+    if (other >= 0 && std::find(affected.begin(), affected.end(), other) == affected.end())
+      affected.push_back(other);
+  }
+  std::vector<std::vector<int>> rotations_before;
+  for (int n : affected) rotations_before.push_back(rotation_at(mesh, layout, n));
+  int patches_before = context ? context->patches : -1;
+  LayoutTopology before;
+  if (options.full_validation) before = build_topology(mesh, layout);
 
   for (int k = 2; k <= std::max(2, options.max_splice_edges); ++k) {
     Layout trial = layout;
@@ -181,8 +313,19 @@ bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, 
       arc.path = std::move(path);
     }
     if (!ok) continue;
-    if (!validate_layout(mesh, trial).valid()) continue;
-    if (!same_layout_structure(before, build_topology(mesh, trial))) continue;
+    if (options.full_validation) {
+      if (!validate_layout(mesh, trial).valid()) continue;
+      if (!same_layout_structure(before, build_topology(mesh, trial))) continue;
+    } else {
+      bool same = true;
+      for (size_t i = 0; i < affected.size() && same; ++i)
+        same = cyclic_equal(rotations_before[i], rotation_at(mesh, trial, affected[i]));
+      if (!same) continue;
+      if (!(context && context->sphere)) {
+        if (patches_before < 0) patches_before = count_patches(mesh, layout);
+        if (count_patches(mesh, trial) != patches_before) continue;
+      }
+    }
     layout = std::move(trial);
     return true;
   }

@@ -21,7 +21,28 @@ struct RelocationOptions {
   //! Hysteresis: keep the node on its current vertex whenever that vertex is a corner of the
   //! target face and may be relocated there (the paper's rule, false, always takes the nearest).
   bool prefer_node_vertex = false;
+  //! Re-routing checks the result with the full validate_layout + build_topology (O(#F) work
+  //! several times per node switch) instead of the equivalent local test (rotation at the
+  //! affected nodes + patch count). For tests that compare both.
+  bool full_validation = false;
 };
+
+//! Data that stays valid while a layout's nodes move (re-routing keeps the structure): lets
+//! move_node_and_reroute skip recomputing it per call.
+struct RerouteContext {
+  int patches = -1;  //!< patch count of the layout (every accepted move keeps it)
+  //! The mesh is a closed, connected genus-0 surface: a connected layout graph then has
+  //! one (disk) patch per face cycle of its rotation system, so an unchanged rotation system
+  //! implies an unchanged patch count and the flood fill is skipped.
+  bool sphere = false;
+};
+
+//! Fills a RerouteContext for a valid layout on \p mesh.
+RerouteContext make_reroute_context(const TriMesh& mesh, const Layout& layout);
+
+//! Number of patches (face components separated by arc edges and the mesh boundary).
+//! \pre every arc path is an edge chain of \p mesh.
+int count_patches(const TriMesh& mesh, const Layout& layout);
 
 //! True when moving \p vertex of \p mesh to \p target (after first restoring \p restored to
 //! its position in \p original, when restored ≥ 0) keeps every incident face normal within
@@ -54,10 +75,16 @@ std::vector<char> forbidden_relocation_vertices(const TriMesh& mesh, const Layou
 //! whole arc when it is shorter) and gets a new shortest first part from the new vertex that
 //! avoids every other arc and node. The move is kept only if the layout validates and has the
 //! same structure (same patch count, same cyclic order of half-arcs around every node) as
-//! before; otherwise \p layout is left unchanged and false is returned.
+//! before; otherwise \p layout is left unchanged and false is returned. The new vertex must not
+//! hold another node or lie on an arc not incident to the node. Since the old layout is valid,
+//! the same rotation system and patch count imply a valid layout (every patch stays a disk with
+//! the same corners), so only the nodes whose first arc edges changed and the patch count are
+//! checked (RelocationOptions::full_validation re-validates everything). \p context, when
+//! given, supplies the patch count.
 //! \pre layout is valid on \p mesh (connectivity only; positions give the routing metric).
 bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, int new_vertex,
-                           const RelocationOptions& options = {});
+                           const RelocationOptions& options = {},
+                           const RerouteContext* context = nullptr);
 
 //! Same patch count and the same cyclic order of half-arcs around every node.
 bool same_layout_structure(const LayoutTopology& a, const LayoutTopology& b);

@@ -1,9 +1,12 @@
 #include "core/param/parameterization.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
+#include <unordered_map>
+#include <utility>
 
 #include "core/base/errors.h"
 
@@ -114,7 +117,8 @@ double param_signed_area2(const std::vector<std::array<double, 2>>& uv, int f) {
 
 ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layout& layout,
                          const LayoutTopology& topo, const std::vector<int>& p,
-                         const std::vector<double>& theta, const ParamOptions& options)
+                         const std::vector<double>& theta, const ParamOptions& options,
+                         ParamSolver* previous)
     : options_(options), period_jump_(p) {
   const auto t0 = std::chrono::steady_clock::now();
   if (!options_.face_weights.empty() && static_cast<int>(options_.face_weights.size()) != g.n_faces)
@@ -201,6 +205,10 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
     curves = static_cast<int>(curve_edges.size());
     const int t0_index = system_.variables;
     system_.variables += 2 * curves;
+    // The translations appear in every node row whose strip crosses their curve: eliminate
+    // them last (constraints.h).
+    system_.eliminate_last.assign(system_.variables, 0);
+    std::fill(system_.eliminate_last.begin() + t0_index, system_.eliminate_last.end(), 1);
     for (int c = 0; c < curves; ++c) {
       const int tu = t0_index + 2 * c, tv = tu + 1;
       for (const auto& [h, r] : curve_edges[c]) {
@@ -219,6 +227,13 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
       }
     }
     result_.cut_curves = curves;
+  }
+  std::unordered_map<int, double> prescribed_length;  // arc id -> length (--integer)
+  for (const ArcLength& l : options_.arc_lengths) {
+    if (!std::isfinite(l.length))
+      throw InvalidInputError("fixed length of arc " + std::to_string(l.arc_id) +
+                              " is not a finite number");
+    prescribed_length[l.arc_id] = l.length;
   }
   // Arcs: node connection (3); along boundary and pinned arcs every path vertex is on the
   // iso-line.
@@ -268,6 +283,20 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
       Terms row = along_u ? P.v : P.u;
       append(row, along_u ? X.v : X.u, -1.0);
       add_row(row, along_u ? X.cv - P.cv : X.cu - P.cu, origin);
+      if (last) {  // the running coordinate: its change along the arc is the arc's length
+        ArcSpan span;
+        span.arc_id = arc.id;
+        span.terms = along_u ? X.u : X.v;
+        append(span.terms, along_u ? P.u : P.v, -1.0);
+        compact(span.terms);
+        span.constant = along_u ? X.cu - P.cu : X.cv - P.cv;
+        if (const auto it = prescribed_length.find(arc.id); it != prescribed_length.end()) {
+          const int o = system_.add_origin("arc " + std::to_string(arc.id) + " (fixed length " +
+                                           std::to_string(it->second) + ")");
+          add_row(span.terms, it->second - span.constant, o);
+        }
+        arc_spans_.push_back(std::move(span));
+      }
     }
   }
   // Explicit feature edges (layout "features") that are not arcs: iso-lines of the field's
@@ -293,6 +322,7 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
     }
   }
   reduction_ = eliminate_constraints(system_);
+  assembly_ = ReducedAssembly(cut_.corner_wedge, cut_.wedges, system_.variables, reduction_.Z);
   result_.wedges = cut_.wedges;
   result_.cut_edges = cut_.cut_edges;
   result_.constraint_rows = static_cast<int>(system_.rows.size());
@@ -300,18 +330,36 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
   result_.redundant = reduction_.redundant;
   result_.unknowns = static_cast<int>(reduction_.Z.cols());
   result_.timings.setup_s = seconds_since(t0);
+  if (previous && previous != this) std::swap(solver_, previous->solver_);
   solve(mesh, g, theta);
 }
 
 ParamSolver::~ParamSolver() = default;
+
+std::vector<ArcLength> ParamSolver::arc_lengths() const {
+  // Wedge values from the corner values (every corner of a wedge has the same (u, v)).
+  std::vector<std::array<double, 2>> wedge_uv(cut_.wedges, {0.0, 0.0});
+  for (size_t c = 0; c < result_.corner_uv.size() && c < cut_.corner_wedge.size(); ++c)
+    wedge_uv[cut_.corner_wedge[c]] = result_.corner_uv[c];
+  std::vector<ArcLength> out;
+  out.reserve(arc_spans_.size());
+  for (const ArcSpan& span : arc_spans_) {
+    double value = span.constant;
+    for (const auto& [variable, coefficient] : span.terms) {
+      if (variable >= 2 * cut_.wedges) continue;  // spans only involve wedge unknowns
+      value += coefficient * wedge_uv[variable / 2][variable % 2];
+    }
+    out.push_back({span.arc_id, value});
+  }
+  return out;
+}
 
 const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCache& g,
                                            const std::vector<double>& theta) {
   auto t0 = std::chrono::steady_clock::now();
   const int n = system_.variables;
   const double aniso = options_.anisotropic ? options_.anisotropy : 1.0;
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(18 * g.n_faces);
+  assembly_.clear();
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
   double constant = 0;
   for (int f = 0; f < g.n_faces; ++f) {
@@ -325,32 +373,53 @@ const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCa
     const Eigen::Matrix3d Hu = area * G.transpose() * Wu * G;
     const Eigen::Matrix3d Hv = area * G.transpose() * Wv * G;
     const Eigen::Vector3d gu = area * G.transpose() * u, gv = area * G.transpose() * v;
-    int w[3];
-    for (int k = 0; k < 3; ++k) w[k] = cut_.corner_wedge[3 * f + k];
+    assembly_.add_face(f, Hu, Hv);
     for (int k = 0; k < 3; ++k) {
-      rhs(2 * w[k]) += gu(k);
-      rhs(2 * w[k] + 1) += gv(k);
-      for (int l = 0; l < 3; ++l) {
-        triplets.emplace_back(2 * w[k], 2 * w[l], Hu(k, l));
-        triplets.emplace_back(2 * w[k] + 1, 2 * w[l] + 1, Hv(k, l));
-      }
+      const int w = cut_.corner_wedge[3 * f + k];
+      rhs(2 * w) += gu(k);
+      rhs(2 * w + 1) += gv(k);
     }
     constant += 2 * area;
   }
-  Eigen::SparseMatrix<double> H(n, n);
-  H.setFromTriplets(triplets.begin(), triplets.end());
+  assembly_.reduce();
+  const Eigen::SparseMatrix<double>& H = assembly_.H();
   const Eigen::SparseMatrix<double>& Z = reduction_.Z;
-  const Eigen::SparseMatrix<double> A = (Z.transpose() * H * Z).eval();
-  const Eigen::VectorXd b = Z.transpose() * (rhs - H * reduction_.z0);
+  const Eigen::SparseMatrix<double>& A = assembly_.A();
+  const Eigen::VectorXd b = reduction_.z0.isZero(0.0)
+                                ? Eigen::VectorXd(Z.transpose() * rhs)
+                                : Eigen::VectorXd(Z.transpose() * (rhs - H * reduction_.z0));
   result_.timings.assemble_s = seconds_since(t0);
   t0 = std::chrono::steady_clock::now();
   solver_.factorize(A);
   result_.timings.factorize_s = solver_.stats().factorize_s;
   result_.timings.analyze_s = solver_.stats().analyze_s;
   t0 = std::chrono::steady_clock::now();
-  const Eigen::VectorXd y = solver_.solve(b);
+  Eigen::VectorXd y = solver_.solve(b);
+  auto energy_of = [&](const Eigen::VectorXd& yy) {
+    const Eigen::VectorXd xx = Z * yy + reduction_.z0;
+    return std::max(0.0, xx.dot(H * xx) - 2 * rhs.dot(xx) + constant);
+  };
+  result_.orientation = {};
+  if (options_.orientation.enabled &&
+      count_foldovers(cut_.corner_wedge, Z * y + reduction_.z0) > 0) {
+    // Strict orientation constraints (algorithm.md §7.2); when they fail, the unconstrained
+    // solution stays and the report says why.
+    OrientationReport& rep = result_.orientation;
+    try {
+      const Eigen::VectorXd yo = solve_oriented(mesh, g, theta, cut_.corner_wedge, reduction_, A, b,
+                                                y, options_.orientation, &rep, &solver_);
+      rep.energy_before = energy_of(y);
+      rep.energy_after = energy_of(yo);
+      if (rep.foldovers_after < rep.foldovers_before) {
+        y = yo;
+        rep.success = true;
+      }
+    } catch (const SolverError& e) {
+      rep.message = e.what();
+    }
+  }
   const Eigen::VectorXd x = Z * y + reduction_.z0;
-  result_.energy = std::max(0.0, x.dot(H * x) - 2 * rhs.dot(x) + constant);
+  result_.energy = energy_of(y);
   result_.corner_uv.resize(3 * g.n_faces);
   result_.foldovers = 0;
   for (int f = 0; f < g.n_faces; ++f) {
@@ -367,8 +436,7 @@ const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCa
 double ParamSolver::optimal_field_rotation(const TriMesh& mesh, const GeometryCache& g,
                                            const std::vector<double>& theta) {
   const int n = system_.variables;
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(18 * g.n_faces);
+  assembly_.clear();
   Eigen::VectorXd rhs0 = Eigen::VectorXd::Zero(n), rhs1 = Eigen::VectorXd::Zero(n);
   for (int f = 0; f < g.n_faces; ++f) {
     Eigen::Matrix<double, 2, 3> G;
@@ -376,39 +444,68 @@ double ParamSolver::optimal_field_rotation(const TriMesh& mesh, const GeometryCa
     face_gradients(mesh, g, f, G, area);
     if (!options_.face_weights.empty()) area *= options_.face_weights[f];
     const Eigen::Vector2d u(std::cos(theta[f]), std::sin(theta[f])), v(-u.y(), u.x());
-    const Eigen::Matrix3d H = area * G.transpose() * G;
+    const Eigen::Matrix3d Hf = area * G.transpose() * G;
     const Eigen::Vector3d gu = area * G.transpose() * u, gv = area * G.transpose() * v;
-    int w[3];
-    for (int k = 0; k < 3; ++k) w[k] = cut_.corner_wedge[3 * f + k];
+    assembly_.add_face(f, Hf, Hf);
     for (int k = 0; k < 3; ++k) {
       // φ = 0: targets (u, v); φ = 90°: targets (v, −u).
-      rhs0(2 * w[k]) += gu(k);
-      rhs0(2 * w[k] + 1) += gv(k);
-      rhs1(2 * w[k]) += gv(k);
-      rhs1(2 * w[k] + 1) -= gu(k);
-      for (int l = 0; l < 3; ++l) {
-        triplets.emplace_back(2 * w[k], 2 * w[l], H(k, l));
-        triplets.emplace_back(2 * w[k] + 1, 2 * w[l] + 1, H(k, l));
-      }
+      const int w = cut_.corner_wedge[3 * f + k];
+      rhs0(2 * w) += gu(k);
+      rhs0(2 * w + 1) += gv(k);
+      rhs1(2 * w) += gv(k);
+      rhs1(2 * w + 1) -= gu(k);
     }
   }
-  Eigen::SparseMatrix<double> H(n, n);
-  H.setFromTriplets(triplets.begin(), triplets.end());
+  assembly_.reduce();
+  const Eigen::SparseMatrix<double>& H = assembly_.H();
   const Eigen::SparseMatrix<double>& Z = reduction_.Z;
-  const Eigen::SparseMatrix<double> A = (Z.transpose() * H * Z).eval();
-  Eigen::MatrixXd B(Z.cols(), 2);
-  B.col(0) = Z.transpose() * (rhs0 - H * reduction_.z0);
-  B.col(1) = Z.transpose() * (rhs1 - H * reduction_.z0);
+  const Eigen::SparseMatrix<double>& A = assembly_.A();
+  // x(φ) = Z y + z0 minimizes ½xᵀHx − b(φ)ᵀx with b(φ) = cos φ·rhs0 + sin φ·rhs1, so
+  // E(φ) = K − F(φ) with F(φ) = ½ qᵀA⁻¹q + b(φ)ᵀz0, q = Zᵀ(b(φ) − H z0) (K: φ-independent).
+  // Homogeneous constraints (z0 = 0): F is a quadratic form in (cos φ, sin φ), maximized by
+  // its leading eigenvector. Prescribed lengths (ParamOptions::arc_lengths) make z0 ≠ 0: then F
+  // also has linear terms and is maximized over the whole circle.
+  const Eigen::VectorXd Hz0 = H * reduction_.z0;
+  Eigen::MatrixXd B(Z.cols(), 3);
+  B.col(0) = Z.transpose() * rhs0;
+  B.col(1) = Z.transpose() * rhs1;
+  B.col(2) = -(Z.transpose() * Hz0);
   solver_.factorize(A);
   const Eigen::MatrixXd Y = solver_.solve(B);
-  // E(φ) = const − [c s] M [c s]ᵀ with M = Bᵀ Y: maximize the quadratic form.
-  Eigen::Matrix2d M = B.transpose() * Y;
+  Eigen::Matrix3d M = B.transpose() * Y;
   M = 0.5 * (M + M.transpose()).eval();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(M);
-  const Eigen::Vector2d best = eig.eigenvectors().col(1);
-  double phi = std::atan2(best(1), best(0));
-  if (phi > M_PI / 2) phi -= M_PI;
-  if (phi <= -M_PI / 2) phi += M_PI;
+  const double l0 = rhs0.dot(reduction_.z0), l1 = rhs1.dot(reduction_.z0);
+  const bool homogeneous = reduction_.z0.lpNorm<Eigen::Infinity>() == 0.0;
+  if (homogeneous) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(M.topLeftCorner<2, 2>());
+    const Eigen::Vector2d best = eig.eigenvectors().col(1);
+    double phi = std::atan2(best(1), best(0));
+    if (phi > M_PI / 2) phi -= M_PI;
+    if (phi <= -M_PI / 2) phi += M_PI;
+    return phi;
+  }
+  const auto F = [&](double phi) {
+    const Eigen::Vector3d t(std::cos(phi), std::sin(phi), 1.0);
+    return 0.5 * t.dot(M * t) + l0 * t(0) + l1 * t(1);
+  };
+  // Dense sampling, then golden-section refinement around the best sample.
+  constexpr int kSamples = 720;
+  int best = 0;
+  for (int i = 1; i < kSamples; ++i)
+    if (F(-M_PI + 2 * M_PI * i / kSamples) > F(-M_PI + 2 * M_PI * best / kSamples)) best = i;
+  double lo = -M_PI + 2 * M_PI * (best - 1) / kSamples,
+         hi = -M_PI + 2 * M_PI * (best + 1) / kSamples;
+  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
+  for (int it = 0; it < 60; ++it) {
+    const double a = hi - ratio * (hi - lo), b = lo + ratio * (hi - lo);
+    if (F(a) > F(b))
+      hi = b;
+    else
+      lo = a;
+  }
+  double phi = 0.5 * (lo + hi);
+  if (phi > M_PI) phi -= 2 * M_PI;
+  if (phi <= -M_PI) phi += 2 * M_PI;
   return phi;
 }
 

@@ -13,8 +13,17 @@
 #include "core/param/constraints.h"
 #include "core/param/cut_graph.h"
 #include "core/param/labeling.h"
+#include "core/param/orientation.h"
+#include "core/param/reduced_assembly.h"
 
 namespace qs {
+
+//! A prescribed parametric length of one arc (the `--integer` option, paper §8).
+struct ArcLength {
+  int arc_id = -1;    //!< LayoutArc::id
+  double length = 0;  //!< signed, parameter units: the change of the arc's running coordinate
+                      //!< (u or v) from its start node to its end node (ParamSolver::arc_lengths)
+};
 
 struct ParamOptions {
   //! Anisotropic norm (BZK09): misalignment is penalised `anisotropy` times more than scale.
@@ -23,6 +32,13 @@ struct ParamOptions {
   //! Per-face weights w_t multiplying each face's term of (1) (stiffening, algorithm.md §7.1).
   //! Empty (the default) means all 1; otherwise size #F, every entry > 0.
   std::vector<double> face_weights;
+  //! Tri-sector orientation constraints when the solve has fold-overs (algorithm.md §7.2).
+  OrientationOptions orientation;
+  //! Fixed arc lengths (integer patch sizes, paper §8): one linear row per listed arc, added to
+  //! the node-connection constraints. Arcs not in the layout or dangling are ignored. Lengths
+  //! that contradict each other (e.g. two opposite patch sides with different values) make the
+  //! constraint set incompatible (InvalidInputError naming the arcs).
+  std::vector<ArcLength> arc_lengths;
 };
 
 struct ParamTimings {
@@ -39,19 +55,29 @@ struct Parameterization {
   double energy = 0;  //!< E: value of energy (1) at the solution (length² units), weighted by
                       //!< ParamOptions::face_weights when they are set
   int foldovers = 0;  //!< faces with signed parametric area ≤ 0
+  //! The orientation-constrained solve, when ParamOptions::orientation is enabled and the
+  //! unconstrained solution folds (its fold-over count is orientation.foldovers_before).
+  OrientationReport orientation;
   // Diagnostics.
-  int wedges = 0, cut_edges = 0, cut_curves = 0, constraint_rows = 0, eliminated = 0, redundant = 0, unknowns = 0;
+  int wedges = 0, cut_edges = 0, cut_curves = 0, constraint_rows = 0, eliminated = 0, redundant = 0,
+      unknowns = 0;
   ParamTimings timings;
 };
 
 class ParamSolver {
  public:
   //! Builds the cut graph, labels, constraints and their elimination (combinatorial: they do not
-  //! change when vertices move). \throw TopologyError, InvalidInputError (incompatible
-  //! constraints naming arcs), SolverError.
+  //! change when vertices move), then solves once. \p previous (optional): a solver built
+  //! before for the same mesh connectivity (e.g. the node optimizer's last step); this solver
+  //! swaps linear solvers with it, so CHOLMOD's symbolic analysis is reused when the reduced
+  //! matrix has exactly the same sparsity pattern (unchanged combinatorics), and redone
+  //! otherwise. \p previous stays usable (its next solve re-analyzes).
+  //! \throw TopologyError, InvalidInputError (incompatible constraints naming arcs),
+  //! SolverError.
   ParamSolver(const TriMesh& mesh, const GeometryCache& geometry, const Layout& layout,
               const LayoutTopology& topology, const std::vector<int>& period_jump,
-              const std::vector<double>& theta, const ParamOptions& options = {});
+              const std::vector<double>& theta, const ParamOptions& options = {},
+              ParamSolver* previous = nullptr);
   ~ParamSolver();
 
   //! Assembles the energy for the current geometry and field and solves; reuses the symbolic
@@ -61,15 +87,27 @@ class ParamSolver {
 
   //! For a field whose global rotation is free (no direction constraints): the rotation φ
   //! (radians) to add to every θ_t that minimizes the isotropic energy (1) under this solver's
-  //! constraints. E(φ) is a quadratic form in (cos φ, sin φ) because the constraints are
-  //! homogeneous, so two extra back-substitutions give the exact optimum.
+  //! constraints. With homogeneous constraints E(φ) is a quadratic form in (cos φ, sin φ), so
+  //! two extra back-substitutions give the exact optimum (φ in (−90°, 90°]). Prescribed arc
+  //! lengths add terms linear in (cos φ, sin φ); a third back-substitution and a 1-D search
+  //! over the whole circle then give the optimum (φ in (−180°, 180°]).
   double optimal_field_rotation(const TriMesh& mesh, const GeometryCache& geometry,
                                 const std::vector<double>& theta);
 
+  //! Orientation constraints for the following solves (ParamOptions::orientation).
+  void set_orientation(const OrientationOptions& orientation) {
+    options_.orientation = orientation;
+  }
+
   const Parameterization& result() const { return result_; }
+  //! The signed parametric length of every arc with two end nodes, measured on the current
+  //! result (same conventions as ParamOptions::arc_lengths), in layout arc order.
+  std::vector<ArcLength> arc_lengths() const;
   const Labeling& labeling() const { return labeling_; }
   const CutGraph& cut_graph() const { return cut_; }
   const Reduction& reduction() const { return reduction_; }
+  //! The CHOLMOD solver of the reduced system (its stats count analyses and factorizations).
+  const SpdSolver& linear_solver() const { return solver_; }
   const ConstraintSystem& constraints() const { return system_; }
 
  private:
@@ -79,8 +117,17 @@ class ParamSolver {
   Labeling labeling_;
   ConstraintSystem system_;
   Reduction reduction_;
+  ReducedAssembly assembly_;  //!< fixed patterns of H and A = ZᵀHZ (built with reduction_)
   SpdSolver solver_{"parameterization"};
   Parameterization result_;
+  //! Per arc with an end node: the running-coordinate difference end − start as an affine
+  //! expression in the wedge unknowns (terms, constant).
+  struct ArcSpan {
+    int arc_id = -1;
+    std::vector<std::pair<int, double>> terms;
+    double constant = 0;
+  };
+  std::vector<ArcSpan> arc_spans_;
 };
 
 //! Energy (1) per face for given corner values (same conventions as the solver). Size #F.

@@ -8,10 +8,10 @@
 
 namespace qs {
 
-Pipeline::Pipeline(TriMesh mesh, Layout layout, PipelineOptions options)
+Pipeline::Pipeline(TriMesh mesh, Layout layout, PipelineOptions options, bool validate)
     : mesh_(std::move(mesh)), layout_(std::move(layout)), options_(std::move(options)) {
-  validation_ = validate_layout(mesh_, layout_);
-  if (!validation_.valid()) {
+  if (validate) validation_ = validate_layout(mesh_, layout_);
+  if (validate && !validation_.valid()) {
     std::ostringstream ss;
     ss << "invalid layout: " << validation_.errors() << " error(s)";
     for (const auto& issue : validation_.issues)
@@ -23,6 +23,18 @@ Pipeline::Pipeline(TriMesh mesh, Layout layout, PipelineOptions options)
 }
 
 Pipeline::~Pipeline() = default;
+
+void Pipeline::update_positions(const TriMesh& mesh) {
+  if (mesh.n_vertices() != mesh_.n_vertices() || mesh.n_faces() != mesh_.n_faces())
+    throw InvalidInputError("update_positions: the mesh has " + std::to_string(mesh.n_vertices()) +
+                            " vertices / " + std::to_string(mesh.n_faces()) +
+                            " faces, the pipeline's " + std::to_string(mesh_.n_vertices()) + " / " +
+                            std::to_string(mesh_.n_faces()));
+  for (auto v : mesh_.vertices()) mesh_.set_point(v, mesh.point(v));
+  update_geometry(mesh_, geometry_);
+  curvature_.reset();
+  extraction_.reset();
+}
 
 const CrossField& Pipeline::compute_field() {
   if (!field_solver_) {
@@ -50,9 +62,13 @@ const Parameterization& Pipeline::compute_parameterization() {
   const CrossField& field = field_solver_ ? field_solver_->field() : compute_field();
   extraction_.reset();
   if (!param_solver_) {
+    // With a free rotation the solve after it counts: no orientation constraints before.
+    ParamOptions first = options_.param;
+    if (field.gauge_face >= 0) first.orientation.enabled = false;
     param_solver_ = std::make_unique<ParamSolver>(mesh_, geometry_, layout_, topology_,
-                                                  field.period_jump, field.theta, options_.param);
+                                                  field.period_jump, field.theta, first);
     if (field.gauge_face < 0) return param_solver_->result();
+    param_solver_->set_orientation(options_.param.orientation);
     // No direction constraints: the field's global rotation is free. Take the one that
     // minimizes the energy, not an arbitrary anchor (that would depend on arc routing).
   }

@@ -34,7 +34,9 @@ struct Singularity {
 class Pipeline {
  public:
   //! \throw InvalidInputError when the layout is invalid (the message lists every error).
-  Pipeline(TriMesh mesh, Layout layout, PipelineOptions options = {});
+  //! With \p validate false the caller guarantees a valid layout (e.g. node optimization's
+  //! re-routed layouts, checked structurally by move_node_and_reroute); validation() is empty.
+  Pipeline(TriMesh mesh, Layout layout, PipelineOptions options = {}, bool validate = true);
   ~Pipeline();
 
   const TriMesh& mesh() const { return mesh_; }
@@ -42,6 +44,13 @@ class Pipeline {
   const LayoutTopology& topology() const { return topology_; }
   const GeometryCache& geometry() const { return geometry_; }
   const ValidationResult& validation() const { return validation_; }
+
+  //! Moves the mesh vertices to \p mesh's positions (same connectivity, same layout): updates
+  //! the geometry in place (κ continued, algorithm.md §6.1) and drops the curvature and the
+  //! extraction. The field and parameterization solvers are kept (their combinatorial setup
+  //! and factorization patterns do not depend on positions); call compute_parameterization()
+  //! to re-solve. \throw InvalidInputError when the vertex or face count differs.
+  void update_positions(const TriMesh& mesh);
 
   //! Computes (or re-solves) the cross field. \throw TopologyError, SolverError.
   const CrossField& compute_field();

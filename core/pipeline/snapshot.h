@@ -56,6 +56,19 @@ struct QuadOverlay {
   std::vector<std::string> warnings;
 };
 
+//! The cross field of one step, for display (glyphs and constraint faces).
+struct FieldView {
+  //! Per face (size #F): the field's first direction (unit, in the face plane of the job's
+  //! surface); the second is its 90° rotation about the face normal.
+  std::vector<std::array<float, 3>> direction;
+  //! Faces with a direction constraint in force (reliable curvature, feature or boundary),
+  //! parallel arrays: face index, constrained direction (unit), kind (ConstraintKind value:
+  //! 0 curvature, 1 feature, 2 boundary).
+  std::vector<int> constraint_faces;
+  std::vector<std::array<float, 3>> constraint_direction;
+  std::vector<char> constraint_kind;
+};
+
 //! Immutable job data the exporters need (defined by the job that fills it, e.g. the editor's
 //! pipeline job); the worker only passes the pointer along.
 struct JobExports;
@@ -79,6 +92,8 @@ struct Snapshot {
   std::shared_ptr<const QuadOverlay> quads;
   //! Data for the exporters (null until a step provided it).
   std::shared_ptr<const JobExports> exports;
+  //! Cross field of the latest step that solved one (null until then).
+  std::shared_ptr<const FieldView> field;
 
   //! The mesh the job works on (shared, immutable); null before LoadMesh.
   std::shared_ptr<const TriMesh> mesh;

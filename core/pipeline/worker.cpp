@@ -155,6 +155,7 @@ void Worker::run(std::stop_token stop) {
     current.node_history.clear();
     current.quads.reset();
     current.exports.reset();
+    current.field.reset();
     current.corner_uv.clear();
     current.face_foldover.clear();
   };
@@ -282,6 +283,7 @@ void Worker::run(std::stop_token stop) {
       if (result.nodes) current.node_history.push_back(std::move(result.nodes));
       if (result.quads) current.quads = std::move(result.quads);
       if (result.exports) current.exports = std::move(result.exports);
+      if (result.field) current.field = std::move(result.field);
       if (!result.message.empty()) current.message = result.message;
       if (!result.corner_uv.empty()) current.corner_uv = std::move(result.corner_uv);
       if (!result.face_foldover.empty()) current.face_foldover = std::move(result.face_foldover);

@@ -34,6 +34,11 @@ struct WorkerOptions {
   double publish_interval_ms = 16;  //!< minimum time between intermediate snapshots
   bool node_optimization = true;
   double quad_size = 0.0;  //!< 0: automatic
+  // Pipeline settings of a job (as `quadsketch-cli optimize`); a job keeps those it started with.
+  bool align = true;              //!< false: ignore curvature directions (--no-align)
+  double sharp_angle_deg = 35.0;  //!< sharp feature dihedral angle (--sharp-angle)
+  double anisotropy = 10.0;       //!< anisotropic norm factor of the parameterization energy
+  double alpha = 0.75;            //!< initial damping α of node-optimization steps
 };
 
 //! What a step function sees of the job: a qs::Observer, so it can be handed straight to
@@ -80,6 +85,7 @@ struct StepResult {
   std::shared_ptr<const NodeFrame> nodes;     //!< appended to Snapshot::node_history
   std::shared_ptr<const QuadOverlay> quads;   //!< replaces Snapshot::quads when set
   std::shared_ptr<const JobExports> exports;  //!< replaces Snapshot::exports when set
+  std::shared_ptr<const FieldView> field;     //!< replaces Snapshot::field when set
   bool validate = true;  //!< run validate_layout on the state's layout for the snapshot
 };
 

@@ -15,6 +15,16 @@ if(TARGET gui_job_test)
   target_sources(gui_job_test PRIVATE ${PROJECT_SOURCE_DIR}/app/gui/pipeline_job.cpp)
 endif()
 
+# gui_field_test.cpp: the job's field snapshot and pipeline options (GL-free), plus the glyph
+# sampling of render/ when the app (and with it qs_render) is built.
+if(TARGET gui_field_test)
+  target_sources(gui_field_test PRIVATE ${PROJECT_SOURCE_DIR}/app/gui/pipeline_job.cpp)
+  if(TARGET qs_render)
+    target_link_libraries(gui_field_test PRIVATE qs_render)
+    target_compile_definitions(gui_field_test PRIVATE QS_TEST_RENDER)
+  endif()
+endif()
+
 if(NOT QS_BUILD_APP)
   return()
 endif()
@@ -39,6 +49,28 @@ add_test(NAME gui_smoke_screenshot
     --out ${QS_GUI_SMOKE_DIR}/example.png --width 1280 --height 800)
 set_tests_properties(gui_smoke_screenshot PROPERTIES
   SKIP_RETURN_CODE 77 TIMEOUT 120 ENVIRONMENT "${QS_GUI_TEST_ENV}")
+
+# The stroke tool and the cross-field glyph layer: the example layout without arc 10, the arc
+# drawn back with a scripted free-hand stroke (--stroke-vertices, through the old path), then a
+# run with the glyph layer on. Expected in the picture: the selected stroke arc's gold underlay
+# and the blue field crosses. string(JSON) needs CMake 3.19.
+if(CMAKE_VERSION VERSION_GREATER_EQUAL 3.19)
+  file(READ ${QS_ASSETS_DIR}/example/ellipsoid.layout.json qs_example_layout)
+  string(JSON qs_arc10_id GET "${qs_example_layout}" arcs 10 id)
+  if(qs_arc10_id EQUAL 10)
+    string(JSON qs_minus_arc10 REMOVE "${qs_example_layout}" arcs 10)
+    file(WRITE ${QS_GUI_SMOKE_DIR}/ellipsoid_minus_arc10.layout.json "${qs_minus_arc10}")
+    add_test(NAME gui_smoke_stroke_and_field
+      COMMAND gui_smoke_check screenshot --app $<TARGET_FILE:quadsketch>
+        --mesh ${QS_ASSETS_DIR}/example/ellipsoid.obj
+        --layout ${QS_GUI_SMOKE_DIR}/ellipsoid_minus_arc10.layout.json
+        --out ${QS_GUI_SMOKE_DIR}/stroke_field.png --width 1280 --height 800
+        --expect-colors "255,219,38,150;102,31,158,1500"
+        -- --stroke-vertices 464,466,844,835,837,839,841,842 --show-field --run)
+    set_tests_properties(gui_smoke_stroke_and_field PROPERTIES
+      SKIP_RETURN_CODE 77 TIMEOUT 300 ENVIRONMENT "${QS_GUI_TEST_ENV}")
+  endif()
+endif()
 
 # Bad input with --quit: message on stderr, exit code 2, no crash (and no display needed).
 add_test(NAME gui_bad_mesh_exits_2

@@ -1,0 +1,105 @@
+// Node-optimization step cost (issue #5): per-step time of optimize_nodes against one
+// parameterization factorization + solve measured in the same process. Not a test.
+//
+//   qs_nodeopt_bench MESH LAYOUT [STEPS=10] [REPEATS=3]
+//
+// Times are CPU seconds of the process (CLOCK_PROCESS_CPUTIME_ID: wall time is meaningless
+// on a shared, overloaded machine); run with OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 so that
+// no spinning helper thread is counted. A step's time runs from one observer report to the
+// next. Prints one line per repeat and a summary: the median over repeats of the fresh pipeline
+// (field + parameterization setup and solve), of one parameterization re-solve (assembly +
+// CHOLMOD numeric factorization + back-substitution on the same ParamSolver), of the
+// median descent step, and their ratio; plus the optimizer's work counters.
+#include <time.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <vector>
+
+#include "core/layout/layout_io.h"
+#include "core/mesh/mesh_io.h"
+#include "core/nodeopt/optimizer.h"
+#include "core/pipeline/pipeline.h"
+
+namespace {
+
+double cpu_now() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// CPU time between consecutive reports of descent steps.
+struct StepTimer : qs::Observer {
+  double last = 0;
+  std::vector<double> descent;
+  void on_step(const qs::StepReport& r) override {
+    const double now = cpu_now();
+    if (r.phase == "descent") descent.push_back(now - last);
+    last = now;
+  }
+};
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 3) {
+    std::fprintf(stderr, "usage: %s MESH LAYOUT [STEPS=10] [REPEATS=3]\n", argv[0]);
+    return 2;
+  }
+  try {
+    const qs::TriMesh mesh = qs::load_mesh(argv[1]);
+    const qs::Layout layout = qs::load_layout(argv[2], mesh);
+    const int steps = argc > 3 ? std::atoi(argv[3]) : 10;
+    const int repeats = argc > 4 ? std::atoi(argv[4]) : 3;
+    const qs::PipelineOptions options;
+    std::vector<double> fresh, resolve, step, total, ratio;
+    for (int rep = 0; rep < repeats; ++rep) {
+      double t0 = cpu_now();
+      qs::Pipeline p(mesh, layout, options);
+      p.compute_field();
+      p.compute_parameterization();
+      fresh.push_back(cpu_now() - t0);
+      // One more parameterization solve on the same solver: assembly + numeric factorization
+      // + back-substitution (the symbolic analysis is kept).
+      t0 = cpu_now();
+      p.compute_parameterization();
+      resolve.push_back(cpu_now() - t0);
+
+      qs::NodeOptOptions no;
+      no.max_steps = steps;
+      qs::NodeOptStats stats;
+      StepTimer timer;
+      t0 = timer.last = cpu_now();
+      const qs::NodeOptResult r =
+          qs::optimize_nodes(mesh, layout, options, no, &timer, nullptr, &stats);
+      total.push_back(cpu_now() - t0);
+      step.push_back(median(timer.descent));
+      ratio.push_back(step.back() / resolve.back());
+      std::printf(
+          "repeat %d: fresh pipeline %.3f s, param re-solve %.3f s, median step %.3f s "
+          "(%.1fx), optimize %.3f s, steps %d (accepted %d), E %.6g -> %.6g, fresh pipelines "
+          "%d, reused solves %d, gradient reuses %d\n",
+          rep, fresh.back(), resolve.back(), step.back(), ratio.back(), total.back(), r.steps,
+          r.accepted, r.E_init, r.E_final, stats.fresh_pipelines, stats.reused_solves,
+          stats.gradient_reuses);
+    }
+    std::printf(
+        "median: faces %zu, nodes %zu, fresh pipeline %.3f s, param re-solve %.3f s, median "
+        "step %.3f s, step / re-solve %.1f, optimize %.3f s\n",
+        static_cast<size_t>(mesh.n_faces()), layout.nodes.size(), median(fresh), median(resolve),
+        median(step), median(ratio), median(total));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "qs_nodeopt_bench: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

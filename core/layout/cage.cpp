@@ -1,0 +1,616 @@
+#include "core/layout/cage.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "core/base/errors.h"
+#include "core/mesh/closest_point.h"
+#include "core/mesh/mesh_checks.h"
+
+namespace qs {
+
+namespace {
+
+using VH = OpenMesh::VertexHandle;
+
+// good_block()[mask]: the 2×2×2 cell block around a grid vertex, bit dx + 2·dy + 4·dz set for
+// an occupied cell, gives a manifold surface at the vertex: occupied and empty cells are each
+// face-connected inside the block (the boundary curve on the vertex's link sphere is then a
+// single cycle, or empty).
+const std::array<bool, 256>& good_block() {
+  static const std::array<bool, 256> table = [] {
+    std::array<bool, 256> t{};
+    auto connected = [](int set) {
+      if (set == 0) return true;
+      int seen = set & -set, grew = 1;
+      while (grew) {
+        grew = 0;
+        for (int c = 0; c < 8; ++c) {
+          if (!(seen >> c & 1)) continue;
+          for (int axis = 0; axis < 3; ++axis) {
+            const int d = c ^ (1 << axis);
+            if ((set >> d & 1) && !(seen >> d & 1)) {
+              seen |= 1 << d;
+              grew = 1;
+            }
+          }
+        }
+      }
+      return seen == set;
+    };
+    for (int m = 0; m < 256; ++m) t[m] = connected(m) && connected(~m & 255);
+    return t;
+  }();
+  return table;
+}
+
+// Inside test of every cell centre by ray parity along one axis; adds one vote per inside cell.
+void parity_votes(const TriMesh& mesh, const VoxelGrid& g, int a, std::vector<uint8_t>& votes) {
+  const int b = (a + 1) % 3, c = (a + 2) % 3;
+  // Rays run through the cell centres, offset by a small irrational fraction of a cell so
+  // that hits on mesh edges and vertices of axis-aligned models are unlikely.
+  const double jb = g.h * 1.37e-3 * (a + 1), jc = g.h * 0.91e-3 * (a + 2);
+  const int nb = g.dims[b], nc = g.dims[c];
+  std::vector<std::vector<double>> hits(static_cast<size_t>(nb) * nc);
+  for (const auto f : mesh.faces()) {
+    Vec3 p[3];
+    int k = 0;
+    for (const auto v : mesh.fv_range(f)) p[k++] = mesh.point(v);
+    double lob = std::numeric_limits<double>::infinity(), hib = -lob, loc = lob, hic = -lob;
+    for (const Vec3& q : p) {
+      lob = std::min(lob, q[b]);
+      hib = std::max(hib, q[b]);
+      loc = std::min(loc, q[c]);
+      hic = std::max(hic, q[c]);
+    }
+    // Columns whose ray (origin + (j + 0.5)h + jitter) lies in [lo, hi].
+    const int j0 = std::max(0, static_cast<int>(std::ceil((lob - g.origin[b] - jb) / g.h - 0.5)));
+    const int j1 =
+        std::min(nb - 1, static_cast<int>(std::floor((hib - g.origin[b] - jb) / g.h - 0.5)));
+    const int k0 = std::max(0, static_cast<int>(std::ceil((loc - g.origin[c] - jc) / g.h - 0.5)));
+    const int k1 =
+        std::min(nc - 1, static_cast<int>(std::floor((hic - g.origin[c] - jc) / g.h - 0.5)));
+    if (j0 > j1 || k0 > k1) continue;
+    const double area =
+        (p[1][b] - p[0][b]) * (p[2][c] - p[0][c]) - (p[2][b] - p[0][b]) * (p[1][c] - p[0][c]);
+    if (area == 0) continue;  // parallel to the ray
+    for (int j = j0; j <= j1; ++j) {
+      const double yb = g.origin[b] + (j + 0.5) * g.h + jb;
+      for (int kk = k0; kk <= k1; ++kk) {
+        const double yc = g.origin[c] + (kk + 0.5) * g.h + jc;
+        double w[3];
+        for (int e = 0; e < 3; ++e) {
+          const Vec3& u = p[(e + 1) % 3];
+          const Vec3& v = p[(e + 2) % 3];
+          w[e] = ((u[b] - yb) * (v[c] - yc) - (v[b] - yb) * (u[c] - yc)) / area;
+        }
+        if (w[0] < 0 || w[1] < 0 || w[2] < 0) continue;
+        hits[static_cast<size_t>(j) + static_cast<size_t>(nb) * kk].push_back(
+            w[0] * p[0][a] + w[1] * p[1][a] + w[2] * p[2][a]);
+      }
+    }
+  }
+  int idx[3];
+  for (int kk = 0; kk < nc; ++kk) {
+    for (int j = 0; j < nb; ++j) {
+      auto& list = hits[static_cast<size_t>(j) + static_cast<size_t>(nb) * kk];
+      if (list.empty()) continue;
+      std::sort(list.begin(), list.end());
+      size_t passed = 0;
+      idx[b] = j;
+      idx[c] = kk;
+      for (int i = 0; i < g.dims[a]; ++i) {
+        const double x = g.origin[a] + (i + 0.5) * g.h;
+        while (passed < list.size() && list[passed] < x) ++passed;
+        idx[a] = i;
+        if (passed % 2 == 1) ++votes[g.cell(idx[0], idx[1], idx[2])];
+      }
+    }
+  }
+}
+
+// Fills empty cells that cannot be reached from the outer layer through empty cells.
+int fill_voids(VoxelGrid& g) {
+  const int n = static_cast<int>(g.occupied.size());
+  std::vector<char> outside(n, 0);
+  std::vector<int> queue{0};
+  outside[0] = 1;
+  for (size_t head = 0; head < queue.size(); ++head) {
+    const int id = queue[head];
+    const int i = id % g.dims[0], j = (id / g.dims[0]) % g.dims[1],
+              k = id / (g.dims[0] * g.dims[1]);
+    const int nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k},
+                          {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
+    for (const auto& q : nb) {
+      if (q[0] < 0 || q[1] < 0 || q[2] < 0 || q[0] >= g.dims[0] || q[1] >= g.dims[1] ||
+          q[2] >= g.dims[2])
+        continue;
+      const int c = g.cell(q[0], q[1], q[2]);
+      if (outside[c] || g.occupied[c]) continue;
+      outside[c] = 1;
+      queue.push_back(c);
+    }
+  }
+  int filled = 0;
+  for (int c = 0; c < n; ++c) {
+    if (!g.occupied[c] && !outside[c]) {
+      g.occupied[c] = 1;
+      ++filled;
+    }
+  }
+  return filled;
+}
+
+// Flips cells until every grid vertex's block is good. Returns the number of flips, or -1 when
+// some block cannot be repaired.
+int repair_manifold(VoxelGrid& g, const ClosestPointTree& tree, std::vector<char>& flipped) {
+  const auto& good = good_block();
+  std::vector<double> dist(g.occupied.size(), -1.0);
+  auto distance = [&](int c) {
+    if (dist[c] < 0) {
+      const int i = c % g.dims[0], j = (c / g.dims[0]) % g.dims[1], k = c / (g.dims[0] * g.dims[1]);
+      const Vec3 centre = g.origin + Vec3(i + 0.5, j + 0.5, k + 0.5) * g.h;
+      dist[c] = tree.closest(centre).distance;
+    }
+    return dist[c];
+  };
+  int flips = 0;
+  for (int pass = 0; pass < 64; ++pass) {
+    int bad = 0, stuck = 0;
+    for (int z = 1; z < g.dims[2]; ++z) {
+      for (int y = 1; y < g.dims[1]; ++y) {
+        for (int x = 1; x < g.dims[0]; ++x) {
+          int cells[8], mask = 0;
+          for (int bit = 0; bit < 8; ++bit) {
+            cells[bit] = g.cell(x - 1 + (bit & 1), y - 1 + (bit >> 1 & 1), z - 1 + (bit >> 2 & 1));
+            if (g.occupied[cells[bit]]) mask |= 1 << bit;
+          }
+          if (good[mask]) continue;
+          ++bad;
+          int best = -1;
+          double best_score = std::numeric_limits<double>::infinity();
+          for (int bit = 0; bit < 8; ++bit) {
+            const int c = cells[bit];
+            const int i = c % g.dims[0], j = (c / g.dims[0]) % g.dims[1],
+                      k = c / (g.dims[0] * g.dims[1]);
+            if (flipped[c] || i == 0 || j == 0 || k == 0 || i == g.dims[0] - 1 ||
+                j == g.dims[1] - 1 || k == g.dims[2] - 1)
+              continue;
+            // Repairing flips first, then the cell whose centre is nearest to the surface
+            // (the most uncertain classification); fills win ties.
+            double score = distance(c) / g.h + (good[mask ^ (1 << bit)] ? 0.0 : 100.0);
+            if (g.occupied[c]) score += 1e-6;
+            if (score < best_score) {
+              best_score = score;
+              best = c;
+            }
+          }
+          if (best < 0) {
+            ++stuck;
+            continue;
+          }
+          g.occupied[best] ^= 1;
+          flipped[best] = 1;
+          ++flips;
+        }
+      }
+    }
+    if (bad == 0) return flips;
+    if (stuck == bad) return -1;
+  }
+  return -1;
+}
+
+std::string attempt_text(int resolution, const std::string& what) {
+  return "resolution " + std::to_string(resolution) + ": " + what;
+}
+
+}  // namespace
+
+PolyMesh voxel_cage(const TriMesh& mesh, int resolution, VoxelCageInfo* info, double shift) {
+  if (mesh.n_faces() == 0) throw InvalidInputError("the mesh has no faces");
+  for (const auto e : mesh.edges()) {
+    if (mesh.is_boundary(e)) {
+      throw InvalidInputError("the mesh has a boundary (edge " + std::to_string(e.idx()) +
+                              "); a voxel cage needs a closed surface");
+    }
+  }
+  if (resolution < 2 || resolution > 200) {
+    throw InvalidInputError("the cage resolution must be between 2 and 200 cells (got " +
+                            std::to_string(resolution) + ")");
+  }
+  const double inf = std::numeric_limits<double>::infinity();
+  Vec3 lo(inf, inf, inf), hi(-inf, -inf, -inf);
+  for (const auto v : mesh.vertices()) {
+    lo.minimize(mesh.point(v));
+    hi.maximize(mesh.point(v));
+  }
+  const Vec3 extent = hi - lo;
+  const double longest = std::max({extent[0], extent[1], extent[2]});
+  if (!(longest > 0) || !std::isfinite(longest))
+    throw InvalidInputError("the mesh has an empty or non-finite bounding box");
+  VoxelCageInfo local;
+  VoxelCageInfo& out = info ? *info : local;
+  out = VoxelCageInfo{};
+  VoxelGrid& g = out.grid;
+  g.h = longest / resolution;
+  for (int a = 0; a < 3; ++a) {
+    // At least one cell over the extent, plus two empty layers on each side.
+    g.dims[a] = std::max(1, static_cast<int>(std::ceil(extent[a] / g.h - 1e-9))) + 4;
+    g.origin[a] = 0.5 * (lo[a] + hi[a]) - (0.5 * g.dims[a] + shift) * g.h;
+    if (shift != 0) g.dims[a] += 1;
+  }
+  g.occupied.assign(static_cast<size_t>(g.dims[0]) * g.dims[1] * g.dims[2], 0);
+  std::vector<uint8_t> votes(g.occupied.size(), 0);
+  for (int a = 0; a < 3; ++a) parity_votes(mesh, g, a, votes);
+  for (size_t c = 0; c < votes.size(); ++c) {
+    g.occupied[c] = votes[c] >= 2;
+    out.inside_cells += g.occupied[c];
+  }
+  if (out.inside_cells == 0) {
+    throw InvalidInputError(attempt_text(
+        resolution, "no cell centre lies inside the mesh (the shape is thinner than a cell)"));
+  }
+  const ClosestPointTree tree(mesh);
+  std::vector<char> flipped(g.occupied.size(), 0);
+  for (int round = 0;; ++round) {
+    out.filled_voids += fill_voids(g);
+    const int flips = repair_manifold(g, tree, flipped);
+    if (flips < 0) {
+      throw InvalidInputError(
+          attempt_text(resolution, "the voxel surface could not be made manifold"));
+    }
+    out.flipped_cells += flips;
+    if (flips == 0) break;
+    if (round == 8) {
+      throw InvalidInputError(
+          attempt_text(resolution, "the voxel surface repair did not converge"));
+    }
+  }
+
+  // Boundary faces of the occupied cells, oriented outward.
+  const int gx = g.dims[0] + 1, gy = g.dims[1] + 1;
+  auto grid_id = [&](int x, int y, int z) {
+    return static_cast<long long>(x) + gx * (static_cast<long long>(y) + gy * z);
+  };
+  std::vector<std::array<long long, 4>> quads;
+  for (int k = 1; k + 1 < g.dims[2]; ++k) {
+    for (int j = 1; j + 1 < g.dims[1]; ++j) {
+      for (int i = 1; i + 1 < g.dims[0]; ++i) {
+        if (!g.at(i, j, k)) continue;
+        for (int a = 0; a < 3; ++a) {
+          const int b = (a + 1) % 3, c = (a + 2) % 3;
+          for (int side = 0; side < 2; ++side) {
+            int q[3] = {i, j, k};
+            q[a] += side ? 1 : -1;
+            if (g.at(q[0], q[1], q[2])) continue;
+            int base[3] = {i, j, k};
+            base[a] += side;
+            const int offs[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+            std::array<long long, 4> quad;
+            for (int s = 0; s < 4; ++s) {
+              int p[3] = {base[0], base[1], base[2]};
+              p[b] += offs[s][0];
+              p[c] += offs[s][1];
+              quad[side ? s : 3 - s] = grid_id(p[0], p[1], p[2]);
+            }
+            quads.push_back(quad);
+          }
+        }
+      }
+    }
+  }
+  std::vector<long long> ids;
+  for (const auto& q : quads) ids.insert(ids.end(), q.begin(), q.end());
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  PolyMesh cage;
+  out.grid_vertex.clear();
+  for (long long id : ids) {
+    const int x = static_cast<int>(id % gx), y = static_cast<int>((id / gx) % gy),
+              z = static_cast<int>(id / (static_cast<long long>(gx) * gy));
+    out.grid_vertex.push_back({x, y, z});
+    cage.add_vertex(g.origin + Vec3(x, y, z) * g.h);
+  }
+  for (const auto& q : quads) {
+    std::vector<VH> vs;
+    for (long long id : q)
+      vs.emplace_back(static_cast<int>(std::lower_bound(ids.begin(), ids.end(), id) - ids.begin()));
+    if (!cage.add_face(vs).is_valid()) {
+      throw InvalidInputError(attempt_text(
+          resolution, "internal error: a voxel boundary face could not be added to the cage"));
+    }
+  }
+  MeshReport report;
+  count_topology(cage, report);
+  out.genus = report.genus;
+  out.components = report.components;
+  return cage;
+}
+
+namespace {
+
+// Closest points restricted to faces whose normal agrees with a reference direction, among
+// the faces within a search radius (a uniform hash grid of face bounding boxes); falls back
+// to the unrestricted closest point. Keeps cage vertices on their own side of thin parts.
+class SidedProjector {
+ public:
+  SidedProjector(const TriMesh& mesh, double cell) : mesh_(mesh), tree_(mesh), cell_(cell) {
+    normal_.resize(mesh.n_faces());
+    corners_.resize(mesh.n_faces());
+    const double inf = std::numeric_limits<double>::infinity();
+    lo_ = Vec3(inf, inf, inf);
+    Vec3 hi(-inf, -inf, -inf);
+    for (const auto v : mesh.vertices()) {
+      lo_.minimize(mesh.point(v));
+      hi.maximize(mesh.point(v));
+    }
+    for (int a = 0; a < 3; ++a)
+      dims_[a] = std::max(1, static_cast<int>(std::ceil((hi[a] - lo_[a]) / cell_)) + 1);
+    buckets_.assign(static_cast<size_t>(dims_[0]) * dims_[1] * dims_[2], {});
+    for (const auto f : mesh.faces()) {
+      int k = 0;
+      Vec3 blo(inf, inf, inf), bhi(-inf, -inf, -inf);
+      for (const auto v : mesh.fv_range(f)) {
+        corners_[f.idx()][k++] = mesh.point(v);
+        blo.minimize(mesh.point(v));
+        bhi.maximize(mesh.point(v));
+      }
+      Vec3 n = mesh.calc_face_normal(f);
+      const double len = n.norm();
+      normal_[f.idx()] = len > 0 ? n / len : Vec3(0, 0, 0);
+      const auto a = bucket_of(blo), b = bucket_of(bhi);
+      for (int z = a[2]; z <= b[2]; ++z)
+        for (int y = a[1]; y <= b[1]; ++y)
+          for (int x = a[0]; x <= b[0]; ++x) buckets_[index(x, y, z)].push_back(f.idx());
+    }
+    stamp_.assign(mesh.n_faces(), 0);
+  }
+
+  const Vec3& face_normal(int f) const { return normal_[f]; }
+
+  //! Closest point on a face within \p radius whose normal has a positive dot product with
+  //! \p reference (unrestricted closest point when there is none).
+  ClosestPoint project(const Vec3& p, const Vec3& reference, double radius) {
+    const ClosestPoint nearest = tree_.closest(p);
+    if (OpenMesh::dot(normal_[nearest.face], reference) > 0) return nearest;
+    ClosestPoint best;
+    best.distance = std::numeric_limits<double>::infinity();
+    const auto a = bucket_of(p - Vec3(radius, radius, radius));
+    const auto b = bucket_of(p + Vec3(radius, radius, radius));
+    ++current_;
+    for (int z = a[2]; z <= b[2]; ++z) {
+      for (int y = a[1]; y <= b[1]; ++y) {
+        for (int x = a[0]; x <= b[0]; ++x) {
+          for (int f : buckets_[index(x, y, z)]) {
+            if (stamp_[f] == current_) continue;
+            stamp_[f] = current_;
+            if (OpenMesh::dot(normal_[f], reference) <= 0) continue;
+            const auto& c = corners_[f];
+            const TrianglePoint tp = closest_point_on_triangle(p, c[0], c[1], c[2]);
+            if (tp.distance < best.distance) {
+              best.distance = tp.distance;
+              best.point = tp.point;
+              best.face = f;
+              best.bary = tp.bary;
+            }
+          }
+        }
+      }
+    }
+    if (best.face < 0 || best.distance > radius) return nearest;
+    return best;
+  }
+
+ private:
+  std::array<int, 3> bucket_of(const Vec3& p) const {
+    std::array<int, 3> b;
+    for (int a = 0; a < 3; ++a)
+      b[a] = std::clamp(static_cast<int>(std::floor((p[a] - lo_[a]) / cell_)), 0, dims_[a] - 1);
+    return b;
+  }
+  size_t index(int x, int y, int z) const {
+    return static_cast<size_t>(x) +
+           static_cast<size_t>(dims_[0]) * (y + static_cast<size_t>(dims_[1]) * z);
+  }
+
+  const TriMesh& mesh_;
+  ClosestPointTree tree_;
+  double cell_;
+  Vec3 lo_;
+  std::array<int, 3> dims_{{1, 1, 1}};
+  std::vector<std::vector<int>> buckets_;
+  std::vector<Vec3> normal_;
+  std::vector<std::array<Vec3, 3>> corners_;
+  std::vector<int> stamp_;
+  int current_ = 0;
+};
+
+// Area-weighted (Newell) normal of a polygon-mesh vertex.
+Vec3 cage_vertex_normal(const PolyMesh& cage, VH v) {
+  Vec3 n(0, 0, 0);
+  for (const auto f : cage.vf_range(v)) {
+    for (const auto h : cage.fh_range(f)) {
+      n += OpenMesh::cross(cage.point(cage.from_vertex_handle(h)),
+                           cage.point(cage.to_vertex_handle(h)));
+    }
+  }
+  return n;
+}
+
+}  // namespace
+
+int fit_cage(PolyMesh& cage, const TriMesh& mesh, const CageFitOptions& options) {
+  const size_t nv = cage.n_vertices();
+  if (nv == 0) return 0;
+  double mean_edge = 0;
+  for (const auto e : cage.edges()) mean_edge += cage.calc_edge_length(e);
+  mean_edge /= std::max<size_t>(1, cage.n_edges());
+  SidedProjector projector(mesh, mean_edge);
+  std::vector<Vec3> cage_normal(nv), next(nv);
+  for (const auto v : cage.vertices()) cage_normal[v.idx()] = cage_vertex_normal(cage, v);
+  std::vector<int> face(nv, -1);
+  auto neighbour_mean = [&](VH v) {
+    Vec3 sum(0, 0, 0);
+    int count = 0;
+    for (const auto w : cage.vv_range(v)) {
+      sum += cage.point(w);
+      ++count;
+    }
+    return count ? sum / count : cage.point(v);
+  };
+  for (int it = 0; it < options.presmoothing; ++it) {
+    for (const auto v : cage.vertices()) {
+      next[v.idx()] = cage.point(v) + options.step * (neighbour_mean(v) - cage.point(v));
+    }
+    for (const auto v : cage.vertices()) cage.set_point(v, next[v.idx()]);
+  }
+  const double radius = 3.0 * mean_edge;
+  for (const auto v : cage.vertices()) {
+    const ClosestPoint cp = projector.project(cage.point(v), cage_normal[v.idx()], radius);
+    cage.set_point(v, cp.point);
+    face[v.idx()] = cp.face;
+  }
+  // Tangential spring relaxation: every cage edge pulls/pushes towards the mean edge length,
+  // every quad diagonal towards √2 times it (keeps quads from collapsing onto a line).
+  double rest = 0;
+  for (const auto e : cage.edges()) rest += cage.calc_edge_length(e);
+  rest /= std::max<size_t>(1, cage.n_edges());
+  auto spring = [&](const Vec3& from, const Vec3& to, double length) {
+    const Vec3 d = to - from;
+    const double l = d.norm();
+    return l > 1e-12 * rest ? d * ((l - length) / l) : Vec3(0, 0, 0);
+  };
+  for (int it = 0; it < options.iterations; ++it) {
+    for (const auto v : cage.vertices()) {
+      const Vec3& p = cage.point(v);
+      Vec3 force(0, 0, 0);
+      int count = 0;
+      for (const auto h : cage.voh_range(v)) {
+        force += spring(p, cage.point(cage.to_vertex_handle(h)), rest);
+        ++count;
+        if (cage.is_boundary(h)) continue;
+        // Diagonal of the quad left of h.
+        const auto diag = cage.to_vertex_handle(cage.next_halfedge_handle(h));
+        force += 0.5 * spring(p, cage.point(diag), std::sqrt(2.0) * rest);
+      }
+      const Vec3& n = projector.face_normal(face[v.idx()]);
+      Vec3 d = count ? force / count : force;
+      d -= OpenMesh::dot(d, n) * n;
+      next[v.idx()] = p + options.step * d;
+    }
+    for (const auto v : cage.vertices()) {
+      const ClosestPoint cp =
+          projector.project(next[v.idx()], projector.face_normal(face[v.idx()]), radius);
+      cage.set_point(v, cp.point);
+      face[v.idx()] = cp.face;
+    }
+  }
+  int folded = 0;
+  for (const auto f : cage.faces()) {
+    Vec3 quad_normal(0, 0, 0), surface_normal(0, 0, 0);
+    for (const auto h : cage.fh_range(f)) {
+      quad_normal += OpenMesh::cross(cage.point(cage.from_vertex_handle(h)),
+                                     cage.point(cage.to_vertex_handle(h)));
+      surface_normal += projector.face_normal(face[cage.to_vertex_handle(h).idx()]);
+    }
+    folded += OpenMesh::dot(quad_normal, surface_normal) <= 0;
+  }
+  return folded;
+}
+
+CageResult cage_layout(const TriMesh& mesh, const CageOptions& options) {
+  MeshReport mesh_report;
+  count_topology(mesh, mesh_report);
+  if (mesh_report.components != 1 || mesh_report.boundary_loops != 0) {
+    throw InvalidInputError(
+        "a cage layout needs a closed surface with one component (the mesh has " +
+        std::to_string(mesh_report.components) + " component(s) and " +
+        std::to_string(mesh_report.boundary_loops) + " boundary loop(s))");
+  }
+  CageResult result;
+  std::vector<std::string> failures;
+  BaseComplexOptions bc;
+  bc.all_edges = options.all_edges;
+  for (int attempt = 0; attempt < std::max(1, options.attempts); ++attempt) {
+    const int resolution = options.resolution + attempt / 2;
+    const double shift = attempt % 2 ? 0.5 : 0.0;
+    if (resolution > 200) break;
+    const std::string name =
+        "resolution " + std::to_string(resolution) + (shift != 0 ? " (shifted)" : "");
+    PolyMesh cage;
+    try {
+      cage = voxel_cage(mesh, resolution, &result.voxels, shift);
+    } catch (const InvalidInputError& e) {
+      failures.push_back(e.what());
+      continue;
+    }
+    if (result.voxels.components != 1 || result.voxels.genus != mesh_report.genus) {
+      failures.push_back(name + ": the voxel surface has " +
+                         std::to_string(result.voxels.components) +
+                         " component(s) of total genus " + std::to_string(result.voxels.genus) +
+                         ", the mesh has genus " + std::to_string(mesh_report.genus));
+      continue;
+    }
+    const int folded = fit_cage(cage, mesh, options.fit);
+    const QuadComplex full = base_complex(cage, bc);
+    // The coarsened complex first (when asked for), then the cage's full complex.
+    std::vector<std::pair<QuadComplex, CoarsenStats>> candidates;
+    if (options.coarsen > 0 && !options.all_edges) {
+      CoarsenOptions co;
+      co.max_width = options.coarsen * result.voxels.grid.h;
+      CoarsenStats stats;
+      QuadComplex coarse = coarsen_complex(cage, full, co, &stats);
+      if (stats.chords_collapsed > 0) candidates.emplace_back(std::move(coarse), stats);
+    }
+    CoarsenStats plain;
+    plain.nodes_before = plain.nodes_after = static_cast<int>(full.node_vertex.size());
+    plain.arcs_before = plain.arcs_after = static_cast<int>(full.arcs.size());
+    plain.patches_before = plain.patches_after = full.num_patches;
+    candidates.emplace_back(full, plain);
+    int chosen = -1;
+    for (size_t k = 0; k < candidates.size() && chosen < 0; ++k) {
+      try {
+        result.layout = transfer_complex(cage, candidates[k].first, mesh, options.transfer);
+        chosen = static_cast<int>(k);
+      } catch (const InvalidInputError& e) {
+        // import-quads' hint about its --coarsen option does not apply here.
+        std::string why = e.what();
+        why = why.substr(0, why.find("; --coarsen"));
+        failures.push_back(name + ": " + std::to_string(cage.n_faces()) + " cage quads, " +
+                           std::to_string(candidates[k].first.num_patches) + " patches" +
+                           (candidates[k].second.chords_collapsed ? " (coarsened)" : "") + ", " +
+                           std::to_string(folded) + " folded; transfer failed: " + why);
+      }
+    }
+    if (chosen < 0) continue;
+    QuadComplex complex = std::move(candidates[chosen].first);
+    const CoarsenStats stats = candidates[chosen].second;
+    result.resolution = resolution;
+    result.shift = shift;
+    result.folded_quads = folded;
+    result.complex = std::move(complex);
+    result.coarsen = stats;
+    result.layout.mesh_vertices = static_cast<int>(mesh.n_vertices());
+    result.layout.mesh_faces = static_cast<int>(mesh.n_faces());
+    for (const auto& f : failures) result.warnings.push_back("skipped " + f);
+    if (folded > 0) {
+      result.warnings.push_back(
+          std::to_string(folded) +
+          " cage quad(s) were folded after fitting (the transferred layout still "
+          "validated)");
+    }
+    result.cage = std::move(cage);
+    return result;
+  }
+  std::string msg = "no voxel cage gave a valid layout on this mesh (genus " +
+                    std::to_string(mesh_report.genus) + ", " + std::to_string(mesh.n_faces()) +
+                    " faces); thin parts or narrow gaps need a finer resolution, dense cages "
+                    "a finer mesh:";
+  for (const auto& f : failures) msg += "\n  " + f.substr(0, 400);
+  throw InvalidInputError(msg);
+}
+
+}  // namespace qs

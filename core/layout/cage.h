@@ -1,0 +1,114 @@
+// Quad layouts for triangle meshes without any quad structure: a voxel cage (the boundary
+// surface of the mesh's voxelization, made manifold and checked to have the mesh's genus) is
+// fitted onto the surface and imported through the quad-import machinery (quad_import.h).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/layout/base_complex.h"
+#include "core/layout/layout.h"
+#include "core/layout/quad_import.h"
+#include "core/mesh/mesh.h"
+
+namespace qs {
+
+//! Occupancy grid of a voxelization. Cell (i, j, k), 0 <= i < dims[0] etc., is the box
+//! origin + h·[i, i+1] × [j, j+1] × [k, k+1] (mesh length units). The outermost layer of
+//! cells is always empty.
+struct VoxelGrid {
+  std::array<int, 3> dims{{0, 0, 0}};  //!< cells per axis
+  Vec3 origin{0, 0, 0};                //!< corner of cell (0, 0, 0)
+  double h = 0;                        //!< cell edge length
+  std::vector<uint8_t> occupied;       //!< per cell, index i + dims[0]·(j + dims[1]·k)
+
+  int cell(int i, int j, int k) const { return i + dims[0] * (j + dims[1] * k); }
+  bool at(int i, int j, int k) const { return occupied[cell(i, j, k)] != 0; }
+};
+
+//! What voxel_cage did.
+struct VoxelCageInfo {
+  VoxelGrid grid;         //!< final occupancy (after repairs)
+  int inside_cells = 0;   //!< cells classified inside (ray parity, 2 of 3 axes)
+  int filled_voids = 0;   //!< empty cells not reachable from outside, filled
+  int flipped_cells = 0;  //!< cells filled or carved to make the surface manifold
+  int genus = 0;          //!< of the cage surface
+  int components = 0;     //!< of the cage surface
+  //! Per cage vertex: its grid point (x, y, z), 0 <= x <= dims[0] etc.
+  std::vector<std::array<int, 3>> grid_vertex;
+};
+
+//! The boundary surface of the voxelization of a closed triangle mesh as a pure quad mesh,
+//! one quad per boundary face of the occupied cells, oriented outward, at the voxel
+//! positions. A cell is inside when its centre is inside for the ray parity along at least
+//! two of the three axes (rays slightly offset from the cell centres against exact hits).
+//! Empty cells enclosed by occupied ones are filled; then, until the surface is manifold at
+//! every grid vertex (the occupied and the empty cells of its 2×2×2 block are each
+//! face-connected in the block), the cell of a bad block whose centre lies closest to the
+//! mesh surface is flipped (preferring flips that repair the block; each cell flips at most
+//! once).
+//! \param resolution cells along the longest bounding-box axis (2..200; memory grows with its
+//! cube). \throw InvalidInputError for a mesh with boundary or without faces, a resolution out of
+//!        range, or a configuration that cannot be repaired.
+//! \param shift offset of the grid along every axis, in cells (another sampling of the shape).
+PolyMesh voxel_cage(const TriMesh& mesh, int resolution, VoxelCageInfo* info = nullptr,
+                    double shift = 0.0);
+
+struct CageFitOptions {
+  //! Uniform Laplacian smoothing rounds of the voxel cage in 3D before the first projection
+  //! (removes the staircase; the projection undoes the shrinking).
+  int presmoothing = 3;
+  //! Rounds of tangential spring relaxation (cage edges towards their mean length, quad
+  //! diagonals towards √2 times it, moved within the surface's tangent plane), each followed
+  //! by a closest-point re-projection onto faces facing the same way.
+  int iterations = 30;
+  double step = 0.5;  //!< fraction of the move towards the neighbours' mean per round
+};
+
+//! Moves the cage's vertices onto \p mesh: presmoothing, closest-point projection, then
+//! tangential smoothing + re-projection. Returns the number of folded quads afterwards (the
+//! normal of the projected quad points against the mesh normal at its corners).
+int fit_cage(PolyMesh& cage, const TriMesh& mesh, const CageFitOptions& options = {});
+
+struct CageOptions {
+  //! Cells along the longest bounding-box axis for the first attempt.
+  int resolution = 12;
+  //! Attempts in all: the grid at resolution, then shifted by half a cell, then resolution + 1,
+  //! shifted, ... until a cage has the mesh's genus and one component and its layout can be
+  //! transferred onto the mesh.
+  int attempts = 8;
+  //! Use every cage edge as an arc (one patch per cage quad) instead of the cage's base
+  //! complex (separatrices of its irregular vertices).
+  bool all_edges = false;
+  //! > 0 (base complex only): collapse the cage complex's thin chords (coarsen_complex) whose
+  //! crossed arcs are at most this many voxel cells long, e.g. the one-cell steps of
+  //! staircases (fewer, larger patches). When the coarsened layout cannot be transferred, the
+  //! full complex is tried next.
+  double coarsen = 1.5;
+  CageFitOptions fit;
+  //! Options of the transfer onto the mesh (all_edges and refine are ignored).
+  QuadImportOptions transfer;
+};
+
+struct CageResult {
+  Layout layout;         //!< valid layout on the input mesh (validate_layout passed)
+  PolyMesh cage;         //!< the fitted cage (vertices on the mesh surface)
+  QuadComplex complex;   //!< the layout on the cage (after coarsening)
+  CoarsenStats coarsen;  //!< before/after counts (equal without coarsening)
+  VoxelCageInfo voxels;
+  int resolution = 0;                 //!< resolution of the attempt that succeeded
+  double shift = 0;                   //!< grid shift (cells) of the attempt that succeeded
+  int folded_quads = 0;               //!< after fit_cage
+  std::vector<std::string> warnings;  //!< attempts that failed, folded quads
+};
+
+//! Builds a quad layout on a closed manifold triangle mesh from its voxel cage
+//! (voxel_cage + fit_cage + base_complex + transfer_complex). The layout is validated and
+//! keeps the cage's cyclic orders (transfer_complex's checks).
+//! \throw InvalidInputError when no attempt succeeds; the message lists every attempt's
+//!        failure (genus/components, or the transfer's error naming nodes/arcs).
+CageResult cage_layout(const TriMesh& mesh, const CageOptions& options = {});
+
+}  // namespace qs

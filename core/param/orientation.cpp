@@ -1,0 +1,435 @@
+#include "core/param/orientation.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "core/base/errors.h"
+#include "core/base/spd_solver.h"
+
+namespace qs {
+
+namespace {
+
+using Vec2 = Eigen::Vector2d;
+
+double cross2(const Vec2& a, const Vec2& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
+
+// Face adjacency across interior edges.
+std::vector<std::vector<int>> face_neighbours(const GeometryCache& g) {
+  std::vector<std::vector<int>> out(g.n_faces);
+  for (int e = 0; e < g.n_edges; ++e) {
+    const int i = g.edge_face_i[e], j = g.edge_face_j[e];
+    if (i < 0 || j < 0) continue;
+    out[i].push_back(j);
+    out[j].push_back(i);
+  }
+  return out;
+}
+
+// Adds `rings` rings of neighbours around the flagged faces (in place).
+void grow(const std::vector<std::vector<int>>& nbr, int rings, std::vector<char>& in) {
+  std::vector<int> front;
+  for (int f = 0; f < static_cast<int>(in.size()); ++f)
+    if (in[f]) front.push_back(f);
+  for (int r = 0; r < rings; ++r) {
+    std::vector<int> next;
+    for (int f : front)
+      for (int n : nbr[f])
+        if (!in[n]) in[n] = 1, next.push_back(n);
+    front.swap(next);
+  }
+}
+
+// The constraint rows C·y ≥ d of the faces in S, scaled by 1/h_t (dimensionless).
+struct ConstraintRows {
+  Eigen::SparseMatrix<double> C;  // m × #y
+  Eigen::VectorXd d;              // m
+  int faces = 0, skipped = 0;
+};
+
+ConstraintRows build_rows(const TriMesh& mesh, const GeometryCache& g,
+                          const std::vector<std::array<std::array<double, 2>, 3>>& ideal,
+                          const std::vector<int>& corner_wedge, const Reduction& red,
+                          const std::vector<char>& in_set, double margin) {
+  std::vector<Eigen::Triplet<double>> trip;
+  int m = 0;
+  ConstraintRows out;
+  for (int f = 0; f < g.n_faces; ++f) {
+    if (!in_set[f]) continue;
+    Vec2 q[3], dir[3];
+    bool ok = true;
+    for (int k = 0; k < 3; ++k) {
+      q[k] = Vec2(ideal[f][k][0], ideal[f][k][1]);
+      const double len = q[k].norm();
+      ok &= len > 0 && std::isfinite(len);
+      dir[k] = ok ? Vec2(q[k] / len) : Vec2::Zero();
+    }
+    ok = ok && cross2(q[0], q[1]) > 0 && cross2(q[1], q[2]) > 0 && cross2(q[2], q[0]) > 0;
+    if (!ok) {
+      ++out.skipped;
+      continue;
+    }
+    Vec2 ray[3];  // ray[k]: bisector of dir[k-1] and dir[k]; sector k runs from ray[k] to ray[k+1]
+    for (int k = 0; k < 3; ++k) ray[k] = (dir[(k + 2) % 3] + dir[k]).normalized();
+    double h = 0;
+    for (int k = 0; k < 3; ++k) {
+      const auto& a = mesh.point(mesh.vertex_handle(g.face_vertices[f][k]));
+      const auto& b = mesh.point(mesh.vertex_handle(g.face_vertices[f][(k + 1) % 3]));
+      h += (a - b).norm() / 3;
+    }
+    for (int k = 0; k < 3; ++k) {
+      // Row 1: ray[k] × D_k ≥ ε; row 2: D_k × ray[k+1] ≥ ε, with D_k = Σ_j (δ_kj − ⅓) P_j.
+      const Vec2 r1 = ray[k], r2 = ray[(k + 1) % 3];
+      for (int j = 0; j < 3; ++j) {
+        const double c = ((j == k) ? 1.0 : 0.0) - 1.0 / 3.0;
+        const int w = corner_wedge[3 * f + j];
+        trip.emplace_back(m, 2 * w, -r1.y() * c / h);
+        trip.emplace_back(m, 2 * w + 1, r1.x() * c / h);
+        trip.emplace_back(m + 1, 2 * w, r2.y() * c / h);
+        trip.emplace_back(m + 1, 2 * w + 1, -r2.x() * c / h);
+      }
+      m += 2;
+    }
+    ++out.faces;
+  }
+  Eigen::SparseMatrix<double, Eigen::RowMajor> Cx(m, red.Z.rows());
+  Cx.setFromTriplets(trip.begin(), trip.end());
+  out.C = (Cx * red.Z).eval();
+  out.C.prune(0.0);
+  out.d = Eigen::VectorXd::Constant(m, margin) - Cx * red.z0;
+  return out;
+}
+
+// Primal-dual interior-point method (Mehrotra predictor-corrector) for
+//   min ½yᵀAy − bᵀy  s.t.  Cy − s = d, s ≥ 0,
+// Newton steps through the normal equations (A + Cᵀ diag(λ/s) C) Δy = …, factorized by
+// CHOLMOD with one symbolic analysis. Infeasible start: y from the caller, s, λ > 0.
+struct IpmOutcome {
+  bool converged = false;
+  bool infeasible = false;
+  int iterations = 0;
+  double primal_residual = 0;
+};
+
+IpmOutcome interior_point(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
+                          const Eigen::SparseMatrix<double>& C, const Eigen::VectorXd& d,
+                          Eigen::VectorXd& y, int max_iterations, double tol) {
+  IpmOutcome out;
+  const int m = static_cast<int>(C.rows());
+  const Eigen::SparseMatrix<double> Ct = C.transpose();
+  SpdSolver solver("orientation constraints");
+  Eigen::VectorXd s = (C * y - d).cwiseMax(1.0);
+  Eigen::VectorXd lambda = Eigen::VectorXd::Ones(m);
+  const double b_scale = 1.0 + b.lpNorm<Eigen::Infinity>();
+
+  // λ/s is clamped: on active constraints it grows without bound as s → 0, and beyond ~1e10
+  // the normal matrix loses positive definiteness to rounding.
+  auto factorize = [&]() {
+    const Eigen::VectorXd D = lambda.cwiseQuotient(s).cwiseMin(1e10);
+    const Eigen::SparseMatrix<double> M = A + Ct * D.asDiagonal() * C;
+    solver.factorize(M);
+  };
+  // Direction for complementarity target r_c (Λ Δs + S Δλ = r_c).
+  auto direction = [&](const Eigen::VectorXd& rd, const Eigen::VectorXd& rp,
+                       const Eigen::VectorXd& rc, Eigen::VectorXd& dy, Eigen::VectorXd& ds,
+                       Eigen::VectorXd& dl) {
+    const Eigen::VectorXd t = (rc - lambda.cwiseProduct(rp)).cwiseQuotient(s);
+    dy = solver.solve(Eigen::VectorXd(-rd + Ct * t));
+    ds = C * dy + rp;
+    dl = (rc - lambda.cwiseProduct(ds)).cwiseQuotient(s);
+  };
+  auto max_step = [](const Eigen::VectorXd& v, const Eigen::VectorXd& dv) {
+    double a = 1.0;
+    for (int i = 0; i < v.size(); ++i)
+      if (dv(i) < 0) a = std::min(a, -v(i) / dv(i));
+    return a;
+  };
+
+  // Starting point (Nocedal & Wright §16.6): one affine step from (y, s, 1), then shift s
+  // and λ away from zero.
+  {
+    factorize();
+    const Eigen::VectorXd rd = A * y - b - Ct * lambda;
+    const Eigen::VectorXd rp = C * y - s - d;
+    Eigen::VectorXd dy, ds, dl;
+    direction(rd, rp, -s.cwiseProduct(lambda), dy, ds, dl);
+    s = (s + ds).cwiseAbs().cwiseMax(1.0);
+    lambda = (lambda + dl).cwiseAbs().cwiseMax(1.0);
+    ++out.iterations;
+  }
+  // Near the end the clamped λ/s makes the Newton steps inexact and the dual residual can
+  // jump; the best iterate that satisfies the constraints (up to kFeasible, a tiny fraction of
+  // the margin) is kept and returned when the tolerance is not reached.
+  constexpr double kFeasible = 1e-6;
+  Eigen::VectorXd y_best;
+  double best_merit = std::numeric_limits<double>::infinity();
+  auto finish = [&]() {
+    if (y_best.size() > 0) {
+      y = y_best;
+      out.primal_residual = 0;
+    } else {
+      out.infeasible = true;
+    }
+    return out;
+  };
+  for (int it = 0; it < max_iterations; ++it) {
+    const Eigen::VectorXd rd = A * y - b - Ct * lambda;
+    const Eigen::VectorXd rp = C * y - s - d;
+    const double mu = s.dot(lambda) / m;
+    const double rd_rel = rd.lpNorm<Eigen::Infinity>() / b_scale;
+    out.primal_residual = rp.lpNorm<Eigen::Infinity>();
+    if (out.primal_residual <= tol && rd_rel <= tol && mu <= tol) {
+      out.converged = true;
+      return out;
+    }
+    if (out.primal_residual <= kFeasible && std::max(rd_rel, mu) < best_merit) {
+      best_merit = std::max(rd_rel, mu);
+      y_best = y;
+    }
+    if (!std::isfinite(mu) || lambda.lpNorm<Eigen::Infinity>() > 1e14) {
+      return finish();  // the multipliers diverge: no point satisfies C y ≥ d
+    }
+    try {
+      factorize();
+    } catch (const SolverError&) {
+      if (y_best.size() > 0) return finish();  // rounding at the end of the iteration
+      throw;
+    }
+    ++out.iterations;
+    Eigen::VectorXd dy, ds, dl;
+    direction(rd, rp, -s.cwiseProduct(lambda), dy, ds, dl);
+    const double a_aff = std::min(max_step(s, ds), max_step(lambda, dl));
+    const double mu_aff = (s + a_aff * ds).dot(lambda + a_aff * dl) / m;
+    const double sigma = std::pow(mu_aff / mu, 3);
+    const Eigen::VectorXd rc =
+        -s.cwiseProduct(lambda) - ds.cwiseProduct(dl) + Eigen::VectorXd::Constant(m, sigma * mu);
+    direction(rd, rp, rc, dy, ds, dl);
+    const double a = std::min(1.0, 0.995 * std::min(max_step(s, ds), max_step(lambda, dl)));
+    y += a * dy;
+    s += a * ds;
+    lambda += a * dl;
+  }
+  const Eigen::VectorXd rp = C * y - s - d;
+  if (rp.lpNorm<Eigen::Infinity>() <= kFeasible) return out;  // the last iterate is feasible
+  return finish();
+}
+
+// The same method on the dual QP  min ½λᵀSλ + gᵀλ, λ ≥ 0  (S PSD, dense m×m), whose optimality
+// conditions s = Sλ + g ≥ 0, λ ≥ 0, s∘λ = 0 are those of the primal QP with y = y0 + Wλ.
+// Newton steps: (S + diag(s/λ)) Δλ = r_c/λ − r_p, Δs = SΔλ + r_p (dense Cholesky).
+IpmOutcome interior_point_dual(const Eigen::MatrixXd& S, const Eigen::VectorXd& g,
+                               Eigen::VectorXd& lambda, int max_iterations, double tol) {
+  IpmOutcome out;
+  const int m = static_cast<int>(S.rows());
+  lambda = Eigen::VectorXd::Ones(m);
+  Eigen::VectorXd s = (S * lambda + g).cwiseMax(1.0);
+  Eigen::LLT<Eigen::MatrixXd> llt;
+  auto factorize = [&]() {
+    Eigen::MatrixXd M = S;
+    M.diagonal() += s.cwiseQuotient(lambda).cwiseMin(1e12);
+    llt.compute(M);
+    if (llt.info() != Eigen::Success)
+      throw SolverError("orientation constraints: dual Newton matrix not positive definite");
+  };
+  auto direction = [&](const Eigen::VectorXd& rp, const Eigen::VectorXd& rc, Eigen::VectorXd& dl,
+                       Eigen::VectorXd& ds) {
+    dl = llt.solve(Eigen::VectorXd(rc.cwiseQuotient(lambda) - rp));
+    ds = S * dl + rp;
+  };
+  auto max_step = [](const Eigen::VectorXd& v, const Eigen::VectorXd& dv) {
+    double a = 1.0;
+    for (int i = 0; i < v.size(); ++i)
+      if (dv(i) < 0) a = std::min(a, -v(i) / dv(i));
+    return a;
+  };
+  {
+    factorize();
+    const Eigen::VectorXd rp = S * lambda + g - s;
+    Eigen::VectorXd dl, ds;
+    direction(rp, -s.cwiseProduct(lambda), dl, ds);
+    s = (s + ds).cwiseAbs().cwiseMax(1.0);
+    lambda = (lambda + dl).cwiseAbs().cwiseMax(1.0);
+    ++out.iterations;
+  }
+  for (int it = 0; it < max_iterations; ++it) {
+    const Eigen::VectorXd rp = S * lambda + g - s;
+    const double mu = s.dot(lambda) / m;
+    out.primal_residual = rp.lpNorm<Eigen::Infinity>();
+    if (out.primal_residual <= tol && mu <= tol) {
+      out.converged = true;
+      return out;
+    }
+    if (!std::isfinite(mu) || lambda.lpNorm<Eigen::Infinity>() > 1e14) {
+      out.infeasible = true;
+      return out;
+    }
+    try {
+      factorize();
+    } catch (const SolverError&) {
+      if (out.primal_residual <= 1e-7 && mu <= 1e-7) {
+        out.converged = true;
+        return out;
+      }
+      throw;
+    }
+    ++out.iterations;
+    Eigen::VectorXd dl, ds;
+    direction(rp, -s.cwiseProduct(lambda), dl, ds);
+    const double a_aff = std::min(max_step(s, ds), max_step(lambda, dl));
+    const double mu_aff = (s + a_aff * ds).dot(lambda + a_aff * dl) / m;
+    const double sigma = std::pow(mu_aff / mu, 3);
+    const Eigen::VectorXd rc =
+        -s.cwiseProduct(lambda) - ds.cwiseProduct(dl) + Eigen::VectorXd::Constant(m, sigma * mu);
+    direction(rp, rc, dl, ds);
+    const double a = std::min(1.0, 0.995 * std::min(max_step(s, ds), max_step(lambda, dl)));
+    lambda += a * dl;
+    s += a * ds;
+  }
+  const Eigen::VectorXd rp = S * lambda + g - s;
+  out.primal_residual = rp.lpNorm<Eigen::Infinity>();
+  // s ≥ 0 always; the constraints hold up to the residual, far below the margin.
+  out.infeasible = out.primal_residual > 1e-6;
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::array<std::array<double, 2>, 3>> ideal_corner_offsets(
+    const TriMesh& mesh, const GeometryCache& g, const std::vector<double>& theta) {
+  std::vector<std::array<std::array<double, 2>, 3>> out(g.n_faces);
+  for (int f = 0; f < g.n_faces; ++f) {
+    const auto p = face_corners_2d(mesh, g, f);
+    const Vec2 c = (Vec2(p[0][0], p[0][1]) + Vec2(p[1][0], p[1][1]) + Vec2(p[2][0], p[2][1])) / 3;
+    const Vec2 u(std::cos(theta[f]), std::sin(theta[f])), v(-u.y(), u.x());
+    const double a2 = cross2(Vec2(p[1][0] - p[0][0], p[1][1] - p[0][1]),
+                             Vec2(p[2][0] - p[0][0], p[2][1] - p[0][1]));
+    for (int k = 0; k < 3; ++k) {
+      const Vec2 q = Vec2(p[k][0], p[k][1]) - c;
+      out[f][k] =
+          a2 > 0 ? std::array<double, 2>{q.dot(u), q.dot(v)} : std::array<double, 2>{0.0, 0.0};
+    }
+  }
+  return out;
+}
+
+int count_foldovers(const std::vector<int>& corner_wedge, const Eigen::VectorXd& x,
+                    std::vector<char>* folded) {
+  const int nf = static_cast<int>(corner_wedge.size() / 3);
+  if (folded) folded->assign(nf, 0);
+  int count = 0;
+  for (int f = 0; f < nf; ++f) {
+    const int a = corner_wedge[3 * f], b = corner_wedge[3 * f + 1], c = corner_wedge[3 * f + 2];
+    const double area2 = (x(2 * b) - x(2 * a)) * (x(2 * c + 1) - x(2 * a + 1)) -
+                         (x(2 * b + 1) - x(2 * a + 1)) * (x(2 * c) - x(2 * a));
+    if (area2 <= 0) {
+      ++count;
+      if (folded) (*folded)[f] = 1;
+    }
+  }
+  return count;
+}
+
+Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& g,
+                               const std::vector<double>& theta,
+                               const std::vector<int>& corner_wedge, const Reduction& red,
+                               const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
+                               const Eigen::VectorXd& y0, const OrientationOptions& o,
+                               OrientationReport* report, SpdSolver* factorized_A) {
+  const auto t0 = std::chrono::steady_clock::now();
+  OrientationReport local;
+  OrientationReport& rep = report ? *report : local;
+  rep = OrientationReport{};
+  rep.ran = true;
+  if (static_cast<int>(corner_wedge.size()) != 3 * g.n_faces ||
+      static_cast<int>(theta.size()) != g.n_faces || y0.size() != A.cols() ||
+      b.size() != A.rows() || red.Z.cols() != A.cols())
+    throw InvalidInputError("orientation constraints: inconsistent problem sizes");
+  if (!(o.margin > 0) || o.rings < 0 || o.max_rounds < 1 || o.max_iterations < 1)
+    throw InvalidInputError("orientation constraints: invalid options");
+
+  std::vector<char> folded;
+  rep.foldovers_before = count_foldovers(corner_wedge, red.Z * y0 + red.z0, &folded);
+  rep.foldovers_after = rep.foldovers_before;
+  if (rep.foldovers_before == 0) return y0;
+
+  const auto ideal = ideal_corner_offsets(mesh, g, theta);
+  const auto nbr = face_neighbours(g);
+  const double h = g.mean_edge_length > 0 ? g.mean_edge_length : 1.0;
+  // Scaled objective (A/h, b/h): residuals and multipliers of order one.
+  const Eigen::SparseMatrix<double> As = A / h;
+  const Eigen::VectorXd bs = b / h;
+  std::vector<char> in_set = folded;
+  Eigen::VectorXd y = y0;
+  // The round with the fewest fold-overs so far (when a later round turns out infeasible).
+  Eigen::VectorXd best_y;
+  int best_folds = rep.foldovers_before;
+  for (int round = 0; round < o.max_rounds; ++round) {
+    grow(nbr, o.rings, in_set);
+    const ConstraintRows rows = build_rows(mesh, g, ideal, corner_wedge, red, in_set, o.margin);
+    rep.constrained_faces = rows.faces;
+    rep.skipped_faces = rows.skipped;
+    ++rep.rounds;
+    if (rows.C.rows() == 0) break;
+    const double m = static_cast<double>(rows.C.rows());
+    const bool dense =
+        factorized_A && factorized_A->factorized() && m <= o.dense_max_rows &&
+        m * static_cast<double>(A.cols()) <= o.dense_max_entries &&
+        m * m * m <= o.dense_cost_ratio * std::pow(static_cast<double>(A.cols()), 1.5);
+    rep.dense = dense;
+    IpmOutcome ipm;
+    if (dense) {
+      // W = A⁻¹Cᵀ (m back-substitutions); for the scaled objective A/h: y = y0 + h·W·λ.
+      const Eigen::MatrixXd W = factorized_A->solve(Eigen::MatrixXd(rows.C.transpose()));
+      const Eigen::MatrixXd S = h * (rows.C * W);
+      const Eigen::VectorXd g = rows.C * y0 - rows.d;
+      Eigen::VectorXd lambda;
+      ipm =
+          interior_point_dual(0.5 * (S + S.transpose()), g, lambda, o.max_iterations, o.tolerance);
+      y = y0 + h * (W * lambda);
+    } else {
+      ipm = interior_point(As, bs, rows.C, rows.d, y, o.max_iterations, o.tolerance);
+      rep.sparse_factorizations += ipm.iterations;
+    }
+    rep.iterations += ipm.iterations;
+    if (ipm.infeasible) {
+      std::ostringstream ss;
+      ss << "orientation constraints are infeasible on " << rows.faces
+         << " constrained faces (round " << round + 1 << ", primal residual " << ipm.primal_residual
+         << ")";
+      rep.message = ss.str();
+      rep.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (best_y.size() == 0) throw SolverError(rep.message);
+      rep.message +=
+          "; kept the best earlier round (" + std::to_string(best_folds) + " fold-overs)";
+      rep.foldovers_after = best_folds;
+      return best_y;
+    }
+    std::vector<char> now;
+    rep.foldovers_after = count_foldovers(corner_wedge, red.Z * y + red.z0, &now);
+    if (rep.foldovers_after < best_folds) best_folds = rep.foldovers_after, best_y = y;
+    if (rep.foldovers_after == 0) break;
+    bool added = false;
+    for (int f = 0; f < g.n_faces; ++f)
+      if (now[f] && !in_set[f]) in_set[f] = 1, added = true;
+    if (!added) break;  // only skipped (degenerate) faces remain folded
+  }
+  if (best_y.size() > 0 && best_folds < rep.foldovers_after) {
+    y = best_y;
+    rep.foldovers_after = best_folds;
+  }
+  if (rep.foldovers_after > 0 && rep.message.empty()) {
+    std::ostringstream ss;
+    ss << rep.foldovers_after << " fold-over(s) remain after " << rep.rounds << " round(s)";
+    rep.message = ss.str();
+  }
+  rep.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return y;
+}
+
+}  // namespace qs

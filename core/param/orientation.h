@@ -1,0 +1,120 @@
+// Strict orientation constraints for the parameterization (paper §6.3 "Limitations of Node
+// Movement", algorithm.md §7.2): linear tri-sector constraints [BCE*13] on the faces that fold,
+// solved as a convex QP in the reduced unknowns by a primal-dual interior-point method whose
+// Newton systems are factorized by CHOLMOD (no extra dependency).
+//
+// Problem. The parameterization solve eliminates every equality constraint exactly:
+// x = Z·y + z0 (x: 2 values (u, v) per wedge, y: the free unknowns), and minimizes
+// ½·yᵀA·y − bᵀy with A = ZᵀHZ SPD. Here we add, for a set S of faces,
+//
+//   min ½·yᵀA·y − bᵀy   subject to   C·y ≥ d,
+//
+// so the equality constraints (seams, node connections, iso-lines) stay satisfied exactly.
+//
+// Tri-sector constraints of face t. Let P_0, P_1, P_2 be its corners in (u, v) (affine in y)
+// and c = (P_0 + P_1 + P_2)/3 their centroid; D_k = P_k − c. The "ideal" offsets Q_k are the
+// 3D corner offsets from the 3D centroid expressed in the field frame (u_t, v_t) of the face —
+// exactly the images under the map the energy (1) aims for (∇u = u_t, ∇v = v_t, a rotation).
+// Let ρ_k be the unit bisector of the (unit) directions of Q_{k−1} and Q_k (indices mod 3).
+// Sector k is the open cone from ρ_k counter-clockwise to ρ_{k+1}; it contains Q_k and is
+// narrower than π because, for a non-degenerate ccw triangle, consecutive Q's are less than π
+// apart. The six linear constraints (× is the 2D cross product a×b = a_x b_y − a_y b_x)
+//
+//   ρ_k × D_k ≥ ε_t   and   D_k × ρ_{k+1} ≥ ε_t        (k = 0, 1, 2)
+//
+// put each D_k strictly inside sector k. Proof that the face is then positively oriented:
+// D_0 + D_1 + D_2 = 0 and the D_k are non-zero, in three disjoint sectors in ccw order, so the
+// ccw angles between consecutive D_k are positive and add up to 2π. If one were ≥ π the three
+// vectors would lie in a closed half-plane; summing to zero they would then be collinear on its
+// boundary line, putting two of them in the same direction, i.e. in the same sector — a
+// contradiction. So each consecutive pair has D_k × D_{k+1} > 0, and twice the signed area
+// (P_1 − P_0) × (P_2 − P_0) = D_0×D_1 + D_1×D_2 + D_2×D_0 > 0. The margin ε_t = margin · h_t
+// (h_t: the face's mean edge length; (u, v) are in length units) keeps the face away from
+// degeneracy. Constraints are only a sufficient (inner, convex) condition for orientation.
+//
+// Two solvers, same optimum. Few constraints (m ≤ dense_max_rows rows and m·#y small): the dual
+// QP in the multipliers λ ≥ 0 — min ½λᵀSλ + gᵀλ with S = C·A⁻¹·Cᵀ, g = C·y0 − d, and
+// y = y0 + A⁻¹Cᵀλ — is dense and small; A⁻¹Cᵀ costs m back-substitutions with the
+// factorization the parameterization already has, and each interior-point iteration only a
+// dense m×m Cholesky (chosen when that is cheaper than a sparse factorization). Otherwise: the
+// primal problem, each iteration factorizing A + Cᵀdiag(λ/s)C with CHOLMOD (one symbolic analysis
+// per active set).
+//
+// Active set. Only faces that need it are constrained: the folded faces of the unconstrained
+// solution and `rings` rings of neighbours around them; when the constrained solution folds
+// other faces, those (and their rings) are added and the QP re-solved (at most max_rounds).
+#pragma once
+
+#include <Eigen/Sparse>
+#include <array>
+#include <string>
+#include <vector>
+
+#include "core/base/spd_solver.h"
+#include "core/mesh/geometry.h"
+#include "core/mesh/mesh.h"
+#include "core/param/constraints.h"
+
+namespace qs {
+
+struct OrientationOptions {
+  //! Apply the constraints in the parameterization solve when it has fold-overs
+  //! (ParamOptions::orientation; the node optimizer enables it for its last solve).
+  bool enabled = false;
+  int rings = 2;            //!< neighbour rings (across edges) added around each folded face
+  int max_rounds = 5;       //!< active-set growth rounds (QP solves) at most
+  int max_iterations = 60;  //!< interior-point iterations per QP at most (one factorization each)
+  double margin = 1e-3;     //!< ε_t = margin · (mean edge length of face t)
+  double tolerance = 1e-9;  //!< on the scaled primal residual, dual residual and complementarity
+  //! The dense dual solver is used up to this many constraint rows (6 per constrained face)
+  //! and while rows × unknowns ≤ dense_max_entries (memory of A⁻¹Cᵀ); 0 disables it.
+  int dense_max_rows = 900;
+  double dense_max_entries = 2e7;
+  //! … and while m³ ≤ dense_cost_ratio · #y^1.5: a dense m×m Cholesky per iteration must stay
+  //! cheaper than a sparse factorization (≈ #y^1.5 for surface meshes). Deterministic choice.
+  double dense_cost_ratio = 100.0;
+};
+
+struct OrientationReport {
+  bool ran = false;  //!< fold-overs were present and the constrained QP was attempted
+  //! The result was used: it has fewer fold-overs than before (set by ParamSolver::solve).
+  bool success = false;
+  int foldovers_before = 0, foldovers_after = 0;
+  int constrained_faces = 0;                   //!< |S| in the last round
+  int skipped_faces = 0;                       //!< faces of S left out: degenerate 3D triangle
+  int rounds = 0;                              //!< QP solves
+  int iterations = 0;                          //!< interior-point iterations in total
+  int sparse_factorizations = 0;               //!< CHOLMOD factorizations (primal solver only)
+  bool dense = false;                          //!< the last round used the dense dual solver
+  double energy_before = 0, energy_after = 0;  //!< value of the (weighted) energy (1)
+  double time_s = 0;
+  std::string message;  //!< why it failed, if it did
+};
+
+//! Per-face ideal corner offsets Q_k (see above) in the field frame, [f][k] = (u, v), length
+//! units; all zero for a degenerate face. Size #F.
+std::vector<std::array<std::array<double, 2>, 3>> ideal_corner_offsets(
+    const TriMesh& mesh, const GeometryCache& geometry, const std::vector<double>& theta);
+
+//! Solves the QP above starting from the unconstrained minimizer \p y0 (A·y0 = b).
+//! \p factorized_A, when given, holds a factorization of A (enables the dense dual solver).
+//! \p corner_wedge: wedge of each face corner (size 3·#F; wedge w owns x(2w), x(2w+1)).
+//! Returns the reduced unknowns y of the constrained optimum, with every constrained face
+//! positively oriented; report->foldovers_after counts fold-overs over all faces.
+//! \throw SolverError when the constraints are infeasible for this layout and field (e.g. a
+//! node of very high valence, faces that the equality constraints force to fold) in the first
+//! round. When a later round (a grown set) is infeasible, the earlier round with the fewest
+//! fold-overs is returned and report->message says so.
+Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& geometry,
+                               const std::vector<double>& theta,
+                               const std::vector<int>& corner_wedge, const Reduction& reduction,
+                               const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
+                               const Eigen::VectorXd& y0, const OrientationOptions& options,
+                               OrientationReport* report = nullptr,
+                               SpdSolver* factorized_A = nullptr);
+
+//! Fold-overs (signed parametric area ≤ 0) of x = Z·y + z0. Size-#F flags in \p folded if given.
+int count_foldovers(const std::vector<int>& corner_wedge, const Eigen::VectorXd& x,
+                    std::vector<char>* folded = nullptr);
+
+}  // namespace qs

@@ -1,0 +1,290 @@
+// Voxel-cage layouts for meshes without any quad structure (core/layout/cage.h), and the tests
+// of issues #3 and #4 they make possible on the shared real meshes.
+#include "core/layout/cage.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <numeric>
+
+#include "core/base/errors.h"
+#include "core/field/cross_field.h"
+#include "core/layout/layout_io.h"
+#include "core/layout/validate.h"
+#include "core/mesh/geometry.h"
+#include "core/mesh/mesh_checks.h"
+#include "core/mesh/mesh_io.h"
+#include "core/pipeline/pipeline.h"
+#include "tests/fixtures.h"
+
+namespace qs {
+namespace {
+
+using VH = OpenMesh::VertexHandle;
+
+int euler(const TriMesh& m) {
+  return static_cast<int>(m.n_vertices()) - static_cast<int>(m.n_edges()) +
+         static_cast<int>(m.n_faces());
+}
+
+// Number of grid edges at grid point p that lie on the voxel surface, from the occupancy
+// alone: an edge is on the surface when the 4 cells around it are neither all occupied nor
+// all empty.
+int surface_edges_at(const VoxelGrid& g, const std::array<int, 3>& p) {
+  int count = 0;
+  for (int a = 0; a < 3; ++a) {
+    const int b = (a + 1) % 3, c = (a + 2) % 3;
+    for (int dir : {-1, 0}) {  // the edge from p towards -a (cells at a-index p[a]-1) or +a
+      int occupied = 0;
+      for (int db : {-1, 0}) {
+        for (int dc : {-1, 0}) {
+          std::array<int, 3> cell = p;
+          cell[a] += dir;
+          cell[b] += db;
+          cell[c] += dc;
+          occupied += g.at(cell[0], cell[1], cell[2]);
+        }
+      }
+      count += occupied != 0 && occupied != 4;
+    }
+  }
+  return count;
+}
+
+// The cage of a closed mesh: pure quad, manifold, one component of the given genus, every
+// vertex valence equal to the number of voxel surface edges at its grid corner.
+void expect_cage_matches_voxels(const PolyMesh& cage, const VoxelCageInfo& info, int genus) {
+  EXPECT_TRUE(is_pure_quad(cage));
+  EXPECT_EQ(info.genus, genus);
+  EXPECT_EQ(info.components, 1);
+  MeshReport report;
+  count_topology(cage, report);
+  EXPECT_EQ(report.boundary_loops, 0);
+  EXPECT_EQ(report.genus, genus);
+  ASSERT_EQ(info.grid_vertex.size(), cage.n_vertices());
+  int wrong = 0;
+  for (const auto v : cage.vertices()) {
+    EXPECT_TRUE(cage.is_manifold(v));
+    const int expected = surface_edges_at(info.grid, info.grid_vertex[v.idx()]);
+    if (static_cast<int>(cage.valence(v)) != expected && ++wrong < 5) {
+      ADD_FAILURE() << "cage vertex " << v.idx() << ": valence " << cage.valence(v)
+                    << ", voxel corner has " << expected << " surface edges";
+    }
+  }
+  EXPECT_EQ(wrong, 0);
+}
+
+// A layout on a closed mesh: valid, and the node valences satisfy Σ(4 − valence) = 4χ.
+void expect_valid_closed_layout(const TriMesh& mesh, const Layout& layout) {
+  const ValidationResult validation = validate_layout(mesh, layout);
+  EXPECT_TRUE(validation.valid());
+  for (const auto& issue : validation.issues) ADD_FAILURE() << format_issue(issue);
+  const LayoutTopology topo = build_topology(mesh, layout);
+  int sum = 0;
+  for (int v : topo.valence) sum += 4 - v;
+  EXPECT_EQ(sum, 4 * euler(mesh));
+}
+
+TEST(CageLayout, SphereCageIsAVoxelSurfaceAndItsLayoutIsValid) {
+  const TriMesh mesh = test::cube_sphere(24).mesh;
+  VoxelCageInfo info;
+  const PolyMesh cage = voxel_cage(mesh, 6, &info);
+  expect_cage_matches_voxels(cage, info, 0);
+  EXPECT_GT(cage.n_faces(), 24u);  // rounder than a cube
+  // Every cell of a 6-cell sphere voxelization whose centre is well inside is occupied.
+  const VoxelGrid& g = info.grid;
+  for (int k = 0; k < g.dims[2]; ++k)
+    for (int j = 0; j < g.dims[1]; ++j)
+      for (int i = 0; i < g.dims[0]; ++i) {
+        const Vec3 c = g.origin + Vec3(i + 0.5, j + 0.5, k + 0.5) * g.h;
+        if (c.norm() < 0.9) {
+          EXPECT_TRUE(g.at(i, j, k)) << i << " " << j << " " << k;
+        }
+        if (c.norm() > 1.1) {
+          EXPECT_FALSE(g.at(i, j, k)) << i << " " << j << " " << k;
+        }
+      }
+
+  CageOptions options;
+  options.resolution = 6;
+  options.all_edges = true;
+  const CageResult result = cage_layout(mesh, options);
+  expect_valid_closed_layout(mesh, result.layout);
+  // All edges: one node per cage vertex with the cage vertex's valence, one patch per quad.
+  const LayoutTopology topo = build_topology(mesh, result.layout);
+  ASSERT_EQ(topo.num_nodes, static_cast<int>(result.cage.n_vertices()));
+  EXPECT_EQ(topo.patches.size(), result.cage.n_faces());
+  for (int n = 0; n < topo.num_nodes; ++n) {
+    const int cage_vertex = result.complex.node_vertex[n];
+    EXPECT_EQ(topo.valence[n],
+              surface_edges_at(result.voxels.grid, result.voxels.grid_vertex[cage_vertex]))
+        << "node " << n;
+  }
+}
+
+TEST(CageLayout, TorusCageHasGenusOneAndABaseComplexLayout) {
+  const TriMesh mesh = test::torus_grid(96, 32, 1, 1).mesh;
+  CageOptions options;
+  options.resolution = 10;
+  const CageResult result = cage_layout(mesh, options);
+  VoxelCageInfo info;
+  const PolyMesh cage = voxel_cage(mesh, result.resolution, &info, result.shift);
+  expect_cage_matches_voxels(cage, info, 1);
+  expect_valid_closed_layout(mesh, result.layout);
+  const LayoutTopology topo = build_topology(mesh, result.layout);
+  EXPECT_EQ(static_cast<int>(topo.patches.size()), result.complex.num_patches);
+  EXPECT_EQ(topo.num_nodes, static_cast<int>(result.complex.node_vertex.size()));
+  // Fitted cage vertices lie on the mesh.
+  double worst = 0;
+  for (const auto v : result.cage.vertices()) {
+    const Vec3 p = result.cage.point(v);
+    const double rho = std::hypot(p[0], p[1]) - 2.0;
+    worst = std::max(worst, std::abs(std::hypot(rho, p[2]) - 0.7));
+  }
+  EXPECT_LT(worst, 0.01);  // the triangulated torus deviates from the ideal one by ~0.005
+}
+
+TEST(CageLayout, RefusesMeshesWithBoundaryAndWrongResolutions) {
+  const TriMesh disk = test::disk_grid(8, 8, 2, 2).mesh;
+  EXPECT_THROW(cage_layout(disk), InvalidInputError);
+  const TriMesh sphere = test::cube_sphere(8).mesh;
+  EXPECT_THROW(voxel_cage(sphere, 1), InvalidInputError);
+  try {
+    voxel_cage(sphere, 1000);
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("resolution"), std::string::npos) << e.what();
+  }
+  // A torus voxelized far too coarsely loses its hole: a clear error listing the attempts.
+  const TriMesh torus = test::torus_grid(48, 16, 1, 1).mesh;
+  CageOptions options;
+  options.resolution = 2;
+  options.attempts = 2;
+  try {
+    cage_layout(torus, options);
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("genus"), std::string::npos) << e.what();
+  }
+}
+
+// Shared real meshes -----------------------------------------------------------------------
+
+struct RealCase {
+  const char* file;
+  int resolution;
+  int attempts;
+  double coarsen;
+};
+
+CageResult real_layout(const TriMesh& mesh, const RealCase& c) {
+  CageOptions options;
+  options.resolution = c.resolution;
+  options.attempts = c.attempts;
+  options.coarsen = c.coarsen;
+  return cage_layout(mesh, options);
+}
+
+// Issue #3: the field of a cage layout on a higher-genus model has exactly the layout's
+// singularities, measured on the field alone.
+void check_field_singularities(const RealCase& c, int genus) {
+  const std::string dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes is absent (real-mesh test)";
+  const TriMesh mesh = load_mesh(dir + "/" + c.file);
+  ASSERT_EQ(euler(mesh), 2 - 2 * genus);
+  const CageResult cage = real_layout(mesh, c);
+  expect_valid_closed_layout(mesh, cage.layout);
+  const GeometryCache geometry = build_geometry(mesh);
+  const LayoutTopology topo = build_topology(mesh, cage.layout);
+  const CrossField field = compute_cross_field(mesh, geometry, cage.layout, topo);
+  const std::vector<int> indices = field_quarter_indices(geometry, field.theta);
+  std::vector<int> expected(mesh.n_vertices(), 0);
+  int irregular = 0;
+  for (int n = 0; n < topo.num_nodes; ++n) {
+    expected[cage.layout.nodes[n].vertex] = 4 - topo.valence[n];
+    irregular += topo.valence[n] != 4;
+  }
+  int wrong = 0, spurious = 0;
+  for (const auto v : mesh.vertices()) {
+    if (indices[v.idx()] == expected[v.idx()]) continue;
+    spurious += expected[v.idx()] == 0;
+    if (++wrong <= 5)
+      ADD_FAILURE() << "vertex " << v.idx() << ": index " << indices[v.idx()] << "/4, expected "
+                    << expected[v.idx()] << "/4";
+  }
+  EXPECT_EQ(wrong, 0) << spurious << " of them away from the nodes";
+  EXPECT_EQ(std::accumulate(indices.begin(), indices.end(), 0), 4 * euler(mesh));
+  EXPECT_GT(irregular, 0);
+  std::printf("[stat] %s: resolution %d, %d nodes (%d irregular), %zu patches\n", c.file,
+              cage.resolution, topo.num_nodes, irregular, topo.patches.size());
+}
+
+TEST(CageLayout, FieldSingularitiesOn3HolesGenus3) {
+  check_field_singularities({"3holes.off", 12, 2, 1.5}, 3);
+}
+
+TEST(CageLayout, FieldSingularitiesOnJointGenus2) {
+  check_field_singularities({"joint.obj", 12, 2, 1.5}, 2);
+}
+
+// Issue #4: E° of the aligned parameterization is lower than that of the --no-align baseline
+// with the same layout.
+void check_alignment_lowers_angle_error(const RealCase& c) {
+  const std::string dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes is absent (real-mesh test)";
+  const TriMesh mesh = load_mesh(dir + "/" + c.file);
+  const CageResult cage = real_layout(mesh, c);
+  double angle[2] = {0, 0};
+  for (int aligned = 0; aligned < 2; ++aligned) {
+    PipelineOptions options;
+    options.field.constraints.curvature = aligned != 0;  // as optimize --no-align
+    Pipeline pipeline(mesh, cage.layout, options);
+    pipeline.compute_parameterization();
+    const ParamMetrics m = pipeline.metrics();
+    EXPECT_TRUE(std::isfinite(m.E));
+    angle[aligned] = m.E_angle_deg;
+  }
+  std::printf("[stat] %s: E° aligned %.3f deg, --no-align %.3f deg\n", c.file, angle[1], angle[0]);
+  EXPECT_LT(angle[1], angle[0]);
+}
+
+TEST(CageLayout, AlignmentLowersAngleErrorOnRockerArm) {
+  check_alignment_lowers_angle_error({"rocker-arm.obj", 15, 2, 1.5});
+}
+
+TEST(CageLayout, AlignmentLowersAngleErrorOn3Holes) {
+  check_alignment_lowers_angle_error({"3holes.off", 12, 2, 1.5});
+}
+
+// The command line: writes a layout that loads and validates; a mesh with a boundary is an
+// input error (exit code 2).
+TEST(CageLayout, CommandLine) {
+  if (!std::filesystem::exists(test::cli_path())) GTEST_SKIP() << "quadsketch-cli not built";
+  const std::string dir = test::temp_dir("cage_cli");
+  const test::MeshAndLayout sphere = test::cube_sphere(24);
+  test::write_obj(sphere.mesh, dir + "/sphere.obj");
+  std::string output;
+  const int code = test::run_command(test::cli_path() + " cage-layout --mesh " + dir +
+                                         "/sphere.obj --resolution 6 --all-edges --out " + dir +
+                                         "/sphere.layout.json --cage " + dir + "/cage.obj",
+                                     &output);
+  ASSERT_EQ(code, 0) << output;
+  const TriMesh mesh = load_mesh(dir + "/sphere.obj");
+  const Layout layout = load_layout(dir + "/sphere.layout.json", mesh);
+  expect_valid_closed_layout(mesh, layout);
+  const PolyMesh cage = load_poly_mesh(dir + "/cage.obj");
+  EXPECT_EQ(build_topology(mesh, layout).patches.size(), cage.n_faces());
+
+  const test::MeshAndLayout disk = test::disk_grid(6, 6, 2, 2);
+  test::write_obj(disk.mesh, dir + "/disk.obj");
+  EXPECT_EQ(test::run_command(test::cli_path() + " cage-layout --mesh " + dir + "/disk.obj --out " +
+                                  dir + "/disk.layout.json",
+                              &output),
+            2)
+      << output;
+  EXPECT_NE(output.find("boundary"), std::string::npos) << output;
+}
+
+}  // namespace
+}  // namespace qs

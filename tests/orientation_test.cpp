@@ -1,0 +1,456 @@
+// Fold-over removal by strict orientation constraints (issue #5 item 6, algorithm.md §7.2):
+// the tri-sector QP solver on small hand-made problems, the constrained parameterization on a
+// folding synthetic layout (equality constraints still exact), the node optimizer's final solve
+// on the bundled example and on real layouts.
+#include "core/param/orientation.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/SparseCholesky>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "core/base/errors.h"
+#include "core/layout/layout_io.h"
+#include "core/layout/perturb.h"
+#include "core/layout/quad_import.h"
+#include "core/layout/routing.h"
+#include "core/mesh/mesh_checks.h"
+#include "core/mesh/mesh_io.h"
+#include "core/nodeopt/gradient.h"
+#include "core/nodeopt/optimizer.h"
+#include "core/pipeline/pipeline.h"
+#include "tests/fixtures.h"
+
+namespace qs {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// (a) the QP on one triangle: corners P0 = (0, 0), P1 = (1, 0) fixed (in z0), P2 free or half
+// free (columns of Z).
+
+struct OneTriangle {
+  TriMesh mesh;
+  GeometryCache geometry;
+  std::vector<double> theta;
+  std::vector<int> corner_wedge{0, 1, 2};
+};
+
+OneTriangle one_triangle() {
+  OneTriangle t;
+  const auto a = t.mesh.add_vertex(Vec3(0, 0, 0));
+  const auto b = t.mesh.add_vertex(Vec3(1, 0, 0));
+  const auto c = t.mesh.add_vertex(Vec3(0.5, 0.8, 0));
+  t.mesh.add_face(a, b, c);
+  t.geometry = build_geometry(t.mesh);
+  // Field along the x axis: the ideal map is the identity up to the face frame (r = first edge).
+  t.theta = {0.0};
+  return t;
+}
+
+TEST(OrientationQp, PullsAFoldedCornerBackInsideItsSector) {
+  OneTriangle t = one_triangle();
+  Reduction red;
+  red.z0 = Eigen::VectorXd::Zero(6);
+  red.z0(2) = 1.0;  // P1 = (1, 0)
+  red.Z.resize(6, 2);
+  red.Z.insert(4, 0) = 1.0;  // P2 = (y0, y1)
+  red.Z.insert(5, 1) = 1.0;
+  // Energy |P2 − (0.5, −1)|²: the unconstrained optimum folds the triangle.
+  Eigen::SparseMatrix<double> A(2, 2);
+  A.insert(0, 0) = 1.0;
+  A.insert(1, 1) = 1.0;
+  const Eigen::VectorXd b = Eigen::Vector2d(0.5, -1.0);
+  const Eigen::VectorXd y0 = b;
+  OrientationOptions o;
+  OrientationReport rep;
+  const Eigen::VectorXd y =
+      solve_oriented(t.mesh, t.geometry, t.theta, t.corner_wedge, red, A, b, y0, o, &rep);
+  EXPECT_EQ(rep.foldovers_before, 1);
+  EXPECT_EQ(rep.foldovers_after, 0);
+  EXPECT_EQ(rep.constrained_faces, 1);
+  EXPECT_GT(rep.iterations, 0);
+  // The ideal triangle (0,0), (1,0), (0.5,0.8) and the target are symmetric about u = 0.5, so
+  // is the optimum; it is as low as the sector constraints allow: above the fixed edge (the
+  // face is positively oriented) and below the ideal apex (the energy pulls it down).
+  EXPECT_NEAR(y(0), 0.5, 1e-6);
+  EXPECT_GT(y(1), 0.0);
+  EXPECT_LT(y(1), 0.8);
+  // A weaker pull gives a higher, still constrained optimum; a pull upwards none at all.
+  const Eigen::VectorXd b2 = Eigen::Vector2d(0.5, -0.2);
+  const Eigen::VectorXd y2 =
+      solve_oriented(t.mesh, t.geometry, t.theta, t.corner_wedge, red, A, b2, b2, o, &rep);
+  EXPECT_EQ(rep.foldovers_after, 0);
+  EXPECT_NEAR(y2(1), y(1), 1e-6) << "the same constraint is active";
+}
+
+TEST(OrientationQp, InfeasibleConstraintsThrowSolverError) {
+  OneTriangle t = one_triangle();
+  Reduction red;
+  red.z0 = Eigen::VectorXd::Zero(6);
+  red.z0(2) = 1.0;   // P1 = (1, 0)
+  red.z0(5) = -1.0;  // P2 = (y, −1): always folded
+  red.Z.resize(6, 1);
+  red.Z.insert(4, 0) = 1.0;
+  Eigen::SparseMatrix<double> A(1, 1);
+  A.insert(0, 0) = 1.0;
+  const Eigen::VectorXd b = Eigen::VectorXd::Constant(1, 0.5);
+  OrientationReport rep;
+  EXPECT_THROW(solve_oriented(t.mesh, t.geometry, t.theta, t.corner_wedge, red, A, b, b, {}, &rep),
+               SolverError);
+  EXPECT_TRUE(rep.ran);
+  EXPECT_FALSE(rep.message.empty());
+}
+
+TEST(OrientationQp, NoFoldsReturnsTheUnconstrainedSolution) {
+  OneTriangle t = one_triangle();
+  Reduction red;
+  red.z0 = Eigen::VectorXd::Zero(6);
+  red.z0(2) = 1.0;
+  red.Z.resize(6, 2);
+  red.Z.insert(4, 0) = 1.0;
+  red.Z.insert(5, 1) = 1.0;
+  Eigen::SparseMatrix<double> A(2, 2);
+  A.insert(0, 0) = 1.0;
+  A.insert(1, 1) = 1.0;
+  const Eigen::VectorXd b = Eigen::Vector2d(0.4, 0.9);
+  OrientationReport rep;
+  const Eigen::VectorXd y =
+      solve_oriented(t.mesh, t.geometry, t.theta, t.corner_wedge, red, A, b, b, {}, &rep);
+  EXPECT_EQ(rep.foldovers_before, 0);
+  EXPECT_EQ(rep.iterations, 0);
+  EXPECT_EQ((y - b).norm(), 0.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// (b) the constrained parameterization keeps every equality constraint exact
+
+// Recovers the free unknowns y from the corner values (least squares on the wedge rows of Z)
+// and returns the largest violation of the equality constraints by x = Z·y + z0, plus (in
+// *fit) the largest misfit of the wedge values, which must be ≈ 0 for the check to mean that
+// the corner values satisfy every constraint.
+double constraint_violation(const ParamSolver& solver, const Parameterization& p, double* fit) {
+  const Reduction& red = solver.reduction();
+  const std::vector<int>& cw = solver.cut_graph().corner_wedge;
+  const int wedges = solver.cut_graph().wedges;
+  Eigen::VectorXd xw = Eigen::VectorXd::Zero(2 * wedges);
+  for (size_t c = 0; c < cw.size(); ++c) {
+    xw(2 * cw[c]) = p.corner_uv[c][0];
+    xw(2 * cw[c] + 1) = p.corner_uv[c][1];
+  }
+  const Eigen::SparseMatrix<double> Zw = red.Z.topRows(2 * wedges);
+  const Eigen::SparseMatrix<double> N = Zw.transpose() * Zw;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(N);
+  const Eigen::VectorXd y = ldlt.solve(Zw.transpose() * (xw - red.z0.head(2 * wedges)));
+  const Eigen::VectorXd x = red.Z * y + red.z0;
+  *fit = (x.head(2 * wedges) - xw).lpNorm<Eigen::Infinity>();
+  double worst = 0;
+  for (const LinearRow& row : solver.constraints().rows) {
+    double r = -row.rhs;
+    for (auto [v, c] : row.terms) r += c * x(v);
+    worst = std::max(worst, std::abs(r));
+  }
+  return worst;
+}
+
+// The cube-on-sphere layout with its nodes displaced `rings` rings: the unconstrained
+// parameterization folds.
+Layout displaced(const test::MeshAndLayout& in, int rings, unsigned seed) {
+  PerturbLayoutOptions po;
+  po.rings = rings;
+  po.seed = seed;
+  return perturb_layout(in.mesh, in.layout, po).layout;
+}
+
+PipelineOptions with_orientation(int dense_max_rows = OrientationOptions{}.dense_max_rows) {
+  PipelineOptions o;
+  o.param.orientation.enabled = true;
+  o.param.orientation.dense_max_rows = dense_max_rows;
+  o.param.orientation.dense_cost_ratio = 1e12;  // the dense solver whenever it is allowed
+  return o;
+}
+
+TEST(OrientationParam, RemovesFoldsAndKeepsEqualityConstraintsExact) {
+  const auto in = test::cube_sphere(6);
+  const Layout layout = displaced(in, 4, 1);
+  Pipeline plain(in.mesh, layout, PipelineOptions{});
+  const Parameterization& before = plain.compute_parameterization();
+  Pipeline oriented(in.mesh, layout, with_orientation());
+  const Parameterization& after = oriented.compute_parameterization();
+  const OrientationReport& rep = after.orientation;
+  std::printf(
+      "[stat] displaced sphere: fold-overs %d -> %d, E %.6g -> %.6g, %d faces, %d rounds, "
+      "%d iterations (%s)\n",
+      before.foldovers, after.foldovers, before.energy, after.energy, rep.constrained_faces,
+      rep.rounds, rep.iterations, rep.dense ? "dense" : "sparse");
+  ASSERT_GT(before.foldovers, 5) << "the test case must fold without the constraints";
+  EXPECT_TRUE(rep.ran);
+  EXPECT_TRUE(rep.success) << rep.message;
+  EXPECT_EQ(rep.foldovers_before, before.foldovers);
+  EXPECT_EQ(after.foldovers, 0);
+  for (int f = 0; f < static_cast<int>(in.mesh.n_faces()); ++f)
+    ASSERT_GT(param_signed_area2(after.corner_uv, f), 0.0) << "face " << f;
+  // Constrained optimum: never below the unconstrained one, and only moderately above.
+  EXPECT_GE(after.energy, before.energy * (1 - 1e-12));
+  EXPECT_LE(after.energy, before.energy * 1.15);
+  EXPECT_NEAR(rep.energy_before, before.energy, 1e-9 * before.energy);
+  EXPECT_NEAR(rep.energy_after, after.energy, 1e-9 * after.energy);
+  // Seams, node connections and the fixed point still hold exactly.
+  double fit = 0;
+  const double violation = constraint_violation(*oriented.param_solver(), after, &fit);
+  EXPECT_LT(fit, 1e-9);
+  EXPECT_LT(violation, 1e-9);
+  // Fewer faces than the mesh are constrained (folded faces and their rings only).
+  EXPECT_GT(rep.constrained_faces, 0);
+  EXPECT_LT(rep.constrained_faces, static_cast<int>(in.mesh.n_faces()));
+  // The layout is still realized: every arc traces.
+  EXPECT_TRUE(oriented.extract().structurally_equivalent);
+}
+
+TEST(OrientationParam, DenseDualAndSparsePrimalSolversAgree) {
+  const auto in = test::cube_sphere(6);
+  const Layout layout = displaced(in, 3, 2);
+  Pipeline dense(in.mesh, layout, with_orientation());
+  Pipeline sparse(in.mesh, layout, with_orientation(0));
+  const Parameterization& a = dense.compute_parameterization();
+  const Parameterization& b = sparse.compute_parameterization();
+  ASSERT_GT(a.orientation.foldovers_before, 0);
+  EXPECT_TRUE(a.orientation.dense);
+  EXPECT_FALSE(b.orientation.dense);
+  EXPECT_GT(b.orientation.sparse_factorizations, 0);
+  EXPECT_EQ(a.foldovers, 0);
+  EXPECT_EQ(b.foldovers, 0);
+  EXPECT_NEAR(a.energy, b.energy, 1e-7 * a.energy);
+  double worst = 0;
+  for (size_t c = 0; c < a.corner_uv.size(); ++c)
+    for (int k = 0; k < 2; ++k)
+      worst = std::max(worst, std::abs(a.corner_uv[c][k] - b.corner_uv[c][k]));
+  EXPECT_LT(worst, 1e-4);
+}
+
+TEST(OrientationParam, WithoutFoldsTheSolveIsUnchanged) {
+  const auto in = test::cube_sphere(6);
+  Pipeline plain(in.mesh, in.layout, PipelineOptions{});
+  Pipeline oriented(in.mesh, in.layout, with_orientation());
+  const Parameterization& a = plain.compute_parameterization();
+  const Parameterization& b = oriented.compute_parameterization();
+  ASSERT_EQ(a.foldovers, 0);
+  EXPECT_FALSE(b.orientation.ran);
+  EXPECT_EQ(a.energy, b.energy);
+  EXPECT_EQ(a.corner_uv, b.corner_uv);
+}
+
+// ---------------------------------------------------------------------------------------------
+// (c) the node optimizer's last solve
+
+TEST(OrientationNodeOpt, FoldsLeftByTheDescentAreRemovedByConstraintsNotStiffening) {
+  const auto in = test::cube_sphere(6);
+  const Layout layout = displaced(in, 4, 1);
+  NodeOptOptions no;
+  no.max_steps = 0;  // no descent: the fold-overs of the displaced layout reach the last solve
+  const NodeOptResult r = optimize_nodes(in.mesh, layout, PipelineOptions{}, no);
+  std::printf("[stat] node optimizer: fold-overs %d -> %d (%s), E %.6g -> %.6g\n",
+              r.foldovers_descent, r.foldovers_final,
+              r.orientation_constraints ? "orientation" : "stiffening", r.E_descent, r.E_final);
+  ASSERT_GT(r.foldovers_descent, 0);
+  EXPECT_EQ(r.foldovers_final, 0);
+  EXPECT_TRUE(r.orientation_constraints);
+  EXPECT_TRUE(r.orientation.success);
+  EXPECT_TRUE(r.face_weights.empty()) << "stiffening is only the fallback";
+  EXPECT_EQ(r.stiffening_iterations, 0);
+  EXPECT_GE(r.E_final, r.E_descent * (1 - 1e-12));
+  ASSERT_FALSE(r.reports.empty());
+  EXPECT_EQ(r.reports.back().phase, "orientation");
+  EXPECT_EQ(r.reports.back().foldovers, 0);
+  // Re-solving the result with the reported options reproduces the final solve.
+  PipelineOptions again;
+  again.param.orientation = r.orientation_options;
+  ASSERT_TRUE(again.param.orientation.enabled);
+  Pipeline p(r.mesh, r.layout, again);
+  const Parameterization& par = p.compute_parameterization();
+  EXPECT_EQ(par.foldovers, 0);
+  EXPECT_NEAR(unweighted_energy(p.mesh(), p.geometry(), p.field()->theta, par.corner_uv, {}),
+              r.E_final, 1e-9 * r.E_final);
+  ASSERT_TRUE(r.pipeline && r.pipeline->parameterization());
+  EXPECT_EQ(r.pipeline->parameterization()->foldovers, 0);
+  // Disabled: no constrained solve; stiffening alone takes over.
+  no.orientation_at_end = false;
+  const NodeOptResult s = optimize_nodes(in.mesh, layout, PipelineOptions{}, no);
+  EXPECT_FALSE(s.orientation.ran);
+  EXPECT_FALSE(s.orientation_constraints);
+  EXPECT_EQ(s.foldovers_descent, r.foldovers_descent);
+  std::printf("[stat] stiffening alone: fold-overs %d -> %d, E %.6g\n", s.foldovers_descent,
+              s.foldovers_final, s.E_final);
+}
+
+// The command line reports the counts before / after and the method, and --no-orientation
+// leaves the fold-overs to stiffening.
+TEST(OrientationNodeOpt, CommandLineReportsFoldRemoval) {
+  if (!std::filesystem::exists(test::cli_path())) GTEST_SKIP() << "quadsketch-cli not built";
+  const auto in = test::cube_sphere(6);
+  const std::string dir = test::temp_dir("orientation_cli");
+  test::write_obj(in.mesh, dir + "/mesh.obj");
+  save_layout(displaced(in, 4, 1), dir + "/layout.json", &in.mesh);
+  auto run = [&](const std::string& flags, const std::string& out) {
+    std::string output;
+    const int rc = test::run_command(test::cli_path() + " optimize --quiet --steps 0 --mesh " +
+                                         dir + "/mesh.obj --layout " + dir + "/layout.json --out " +
+                                         dir + "/" + out + " " + flags,
+                                     &output);
+    EXPECT_EQ(rc, 0) << output;
+    std::ifstream f(dir + "/" + out + "/report.json");
+    return nlohmann::json::parse(f);
+  };
+  const auto with = run("", "with"), without = run("--no-orientation", "without");
+  const auto& n = with["node_optimization"];
+  EXPECT_GT(n["foldovers_before_orientation"].get<int>(), 0);
+  EXPECT_EQ(n["foldovers_final"].get<int>(), 0);
+  EXPECT_EQ(n["fold_removal"], "orientation");
+  EXPECT_TRUE(n["orientation"]["success"].get<bool>());
+  EXPECT_EQ(with["metrics"]["foldovers"].get<int>(), 0) << "param.obj is the constrained solve";
+  const double E_descent = n["E_descent"].get<double>(), E_final = with["E_final"].get<double>();
+  EXPECT_GE(E_final, E_descent * (1 - 1e-9));
+  EXPECT_LE(E_final, E_descent * 1.15);
+  const auto& m = without["node_optimization"];
+  EXPECT_FALSE(m["orientation"]["ran"].get<bool>());
+  EXPECT_NE(m["fold_removal"], "orientation");
+  EXPECT_EQ(m["foldovers_before_orientation"], n["foldovers_before_orientation"]);
+}
+
+TEST(OrientationNodeOpt, BundledExampleEndsWithoutFoldovers) {
+  const std::string dir = test::assets_dir() + "/example";
+  const TriMesh mesh = load_mesh(dir + "/ellipsoid.obj");
+  const Layout layout = load_layout(dir + "/ellipsoid.layout.json", mesh);
+  const NodeOptResult r = optimize_nodes(mesh, layout, PipelineOptions{});
+  std::printf(
+      "[stat] example: fold-overs init %d, before orientation %d, final %d; E %.6g -> %.6g\n",
+      r.foldovers_init, r.foldovers_descent, r.foldovers_final, r.E_init, r.E_final);
+  EXPECT_EQ(r.foldovers_final, 0);
+  EXPECT_LE(r.E_final, r.E_init);
+}
+
+// Spot's quad mesh imported as a layout on its own triangulation, optimized: the descent ends
+// with fold-overs (18 when this was written), the constrained last solve has none.
+TEST(OrientationRealData, SpotImportedOntoItselfEndsWithoutFoldovers) {
+  const std::string dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
+  const QuadImportResult imp =
+      import_quads(load_poly_mesh(dir + "/spot/spot_quadrangulated.obj"), nullptr, {});
+  const NodeOptResult r = optimize_nodes(imp.mesh, imp.layout, PipelineOptions{});
+  std::printf(
+      "[stat] spot: fold-overs init %d, before orientation %d, final %d (%s, %d faces, "
+      "%d iterations, %.3f s); E %.6g -> %.6g -> %.6g\n",
+      r.foldovers_init, r.foldovers_descent, r.foldovers_final,
+      r.orientation_constraints ? "orientation" : "no constraints", r.orientation.constrained_faces,
+      r.orientation.iterations, r.orientation.time_s, r.E_init, r.E_descent, r.E_final);
+  EXPECT_EQ(r.foldovers_final, 0) << r.orientation.message;
+  if (r.foldovers_descent > 0) {
+    EXPECT_TRUE(r.orientation_constraints);
+    EXPECT_TRUE(r.face_weights.empty());
+  }
+}
+
+// Fandisk's quad mesh transferred onto fandisk.off (sharp features: iso-line constraints along
+// them), without descent: the initial solve folds (11 faces when this was written); the
+// constrained solve has none. (The full descent takes longer than a unit test should.)
+TEST(OrientationRealData, FandiskInitialLayoutEndsWithoutFoldovers) {
+  const std::string dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
+  const TriMesh target = load_mesh(dir + "/fandisk/fandisk.off");
+  const QuadImportResult imp =
+      import_quads(load_poly_mesh(dir + "/fandisk/fandisk_quads.off"), &target, {});
+  NodeOptOptions no;
+  no.max_steps = 0;
+  const NodeOptResult r = optimize_nodes(imp.mesh, imp.layout, PipelineOptions{}, no);
+  std::printf(
+      "[stat] fandisk: fold-overs %d -> %d (%s, %d faces, %d iterations, %.3f s); "
+      "E %.6g -> %.6g\n",
+      r.foldovers_descent, r.foldovers_final,
+      r.orientation_constraints ? "orientation" : "no constraints", r.orientation.constrained_faces,
+      r.orientation.iterations, r.orientation.time_s, r.E_descent, r.E_final);
+  EXPECT_GT(r.foldovers_descent, 0) << "the case should show fold-overs before";
+  EXPECT_EQ(r.foldovers_final, 0) << r.orientation.message;
+  EXPECT_LE(r.E_final, r.E_descent * 1.05);
+}
+
+// mask_confmap.obj (three boundary loops) with one node and four dangling arcs to the eye
+// holes and the outer boundary (as in boundary_test): the fold-overs where the iso-lines wrap
+// around the free eye holes cannot be removed by the tri-sector constraints (the QP is
+// infeasible). The solve must say so and keep the unconstrained solution; the node optimizer
+// then falls back to stiffening.
+TEST(OrientationRealData, InfeasibleConstraintsOnMaskKeepTheSolveAndSayWhy) {
+  const std::string dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
+  const TriMesh mesh = load_mesh(dir + "/mask_confmap.obj");
+  auto loops = boundary_loops(mesh);
+  ASSERT_EQ(loops.size(), 3u);
+  std::sort(loops.begin(), loops.end(),
+            [](const auto& a, const auto& b) { return a.size() > b.size(); });
+  auto point = [&](int v) { return mesh.point(mesh.vertex_handle(v)); };
+  auto centroid = [&](const std::vector<int>& vs) {
+    Vec3 c(0, 0, 0);
+    for (int v : vs) c += point(v);
+    return c / static_cast<double>(vs.size());
+  };
+  auto nearest = [&](const std::vector<int>& candidates, const Vec3& p) {
+    int best = candidates[0];
+    for (int v : candidates)
+      if ((point(v) - p).sqrnorm() < (point(best) - p).sqrnorm()) best = v;
+    return best;
+  };
+  const Vec3 eye_a = centroid(loops[1]), eye_b = centroid(loops[2]);
+  std::vector<int> interior;
+  for (auto v : mesh.vertices())
+    if (!mesh.is_boundary(v)) interior.push_back(v.idx());
+  const int center = nearest(interior, 0.5 * (eye_a + eye_b));
+  Vec3 normal(0, 0, 0);
+  for (auto f : mesh.faces()) normal += mesh.calc_face_normal(f) * mesh.calc_face_area(f);
+  const Vec3 up_dir = (normal % (eye_b - eye_a)).normalized();
+  int up = loops[0][0], down = loops[0][0];
+  for (int v : loops[0]) {
+    if (((point(v) - point(center)) | up_dir) > ((point(up) - point(center)) | up_dir)) up = v;
+    if (((point(v) - point(center)) | up_dir) < ((point(down) - point(center)) | up_dir)) down = v;
+  }
+  Layout layout;
+  layout.nodes.push_back(LayoutNode{});
+  layout.nodes[0].id = 0;
+  layout.nodes[0].vertex = center;
+  const std::vector<int> targets = {nearest(loops[1], point(center)), up,
+                                    nearest(loops[2], point(center)), down};
+  for (size_t i = 0; i < targets.size(); ++i) {
+    RoutingObstacles obstacles = obstacles_of_layout(mesh, layout);
+    for (auto v : mesh.vertices())
+      if (mesh.is_boundary(v) && v.idx() != targets[i]) obstacles.vertex_blocked[v.idx()] = 1;
+    LayoutArc arc;
+    arc.id = static_cast<int>(i);
+    arc.from = 0;
+    arc.to = -1;
+    arc.path = shortest_path(mesh, center, targets[i], obstacles);
+    ASSERT_GE(arc.path.size(), 2u);
+    layout.arcs.push_back(arc);
+  }
+  PipelineOptions options;
+  options.field.constraints.curvature = false;
+  Pipeline plain(mesh, layout, options);
+  const Parameterization& a = plain.compute_parameterization();
+  options.param.orientation.enabled = true;
+  Pipeline oriented(mesh, layout, options);
+  const Parameterization& b = oriented.compute_parameterization();
+  std::printf("[stat] mask: fold-overs %d -> %d, %s\n", a.foldovers, b.foldovers,
+              b.orientation.message.c_str());
+  ASSERT_GT(a.foldovers, 0);
+  EXPECT_TRUE(b.orientation.ran);
+  if (b.orientation.success) {  // should the constraints ever become feasible here
+    EXPECT_LT(b.foldovers, a.foldovers);
+  } else {
+    EXPECT_NE(b.orientation.message.find("infeasible"), std::string::npos) << b.orientation.message;
+    EXPECT_EQ(b.foldovers, a.foldovers);
+    EXPECT_EQ(b.energy, a.energy);
+  }
+}
+
+}  // namespace
+}  // namespace qs
