@@ -4,8 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <array>
-#include <map>
 
 #include "core/base/errors.h"
 #include "core/mesh/mesh_io.h"
@@ -15,88 +13,10 @@ namespace qs {
 namespace {
 
 using VH = OpenMesh::VertexHandle;
-
-//! Surface of the cube [0,k]^3 as a k×k quad grid per side, outward oriented.
-PolyMesh quad_cube(int k) {
-  PolyMesh mesh;
-  std::map<std::array<int, 3>, VH> lattice;
-  auto vertex = [&](std::array<int, 3> p) {
-    auto it = lattice.find(p);
-    if (it != lattice.end()) return it->second;
-    const VH v = mesh.add_vertex(Vec3(p[0], p[1], p[2]));
-    lattice.emplace(p, v);
-    return v;
-  };
-  for (int axis = 0; axis < 3; ++axis) {
-    for (int side : {0, k}) {
-      // Tangent axes (b, c) with b × c = +axis; swapped on the negative side.
-      int b = (axis + 1) % 3, c = (axis + 2) % 3;
-      if (side == 0) std::swap(b, c);
-      for (int i = 0; i < k; ++i) {
-        for (int j = 0; j < k; ++j) {
-          std::array<int, 3> p{};
-          p[axis] = side;
-          auto at = [&](int di, int dj) {
-            std::array<int, 3> q = p;
-            q[b] = i + di;
-            q[c] = j + dj;
-            return vertex(q);
-          };
-          mesh.add_face(std::vector<VH>{at(0, 0), at(1, 0), at(1, 1), at(0, 1)});
-        }
-      }
-    }
-  }
-  return mesh;
-}
-
-//! nu × nv quad grid on a torus (no irregular vertex).
-PolyMesh quad_torus(int nu, int nv) {
-  PolyMesh mesh;
-  for (int i = 0; i < nu; ++i) {
-    for (int j = 0; j < nv; ++j) {
-      const double t = 2 * M_PI * i / nu, f = 2 * M_PI * j / nv;
-      mesh.add_vertex(Vec3((2 + 0.7 * std::cos(f)) * std::cos(t),
-                           (2 + 0.7 * std::cos(f)) * std::sin(t), 0.7 * std::sin(f)));
-    }
-  }
-  auto id = [&](int i, int j) { return VH(((i + nu) % nu) * nv + (j + nv) % nv); };
-  for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j)
-      mesh.add_face(std::vector<VH>{id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
-  return mesh;
-}
-
-//! Flat nx × ny quad grid (a disk); its 4 corners have valence 2.
-PolyMesh quad_disk(int nx, int ny) {
-  PolyMesh mesh;
-  for (int j = 0; j <= ny; ++j)
-    for (int i = 0; i <= nx; ++i) mesh.add_vertex(Vec3(i, j, 0));
-  auto id = [&](int i, int j) { return VH(j * (nx + 1) + i); };
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i)
-      mesh.add_face(std::vector<VH>{id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
-  return mesh;
-}
-
-//! Flat n × n quad grid without its top-right cell: a disk with one concave corner whose two
-//! separatrices cut thin strips (one cell wide) off the top and right sides.
-PolyMesh notched_disk(int n) {
-  PolyMesh mesh;
-  std::map<std::array<int, 2>, VH> ids;
-  auto at = [&](int i, int j) {
-    auto it = ids.find({i, j});
-    if (it != ids.end()) return it->second;
-    const VH v = mesh.add_vertex(Vec3(i, j, 0));
-    ids.emplace(std::array<int, 2>{i, j}, v);
-    return v;
-  };
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i)
-      if (i != n - 1 || j != n - 1)
-        mesh.add_face(std::vector<VH>{at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
-  return mesh;
-}
+using test::notched_disk;
+using test::quad_cube;
+using test::quad_disk;
+using test::quad_torus;
 
 //! Checks the derived fields of a complex: valences, half-arc lists, arc ends.
 void expect_consistent(const QuadComplex& qc, const std::string& what) {
@@ -286,35 +206,7 @@ TEST(BaseComplexCoarsen, ThinBoxKeepsItsCorners) {
   // A 6 x 6 x 1 box: the chord around the thin side is one cell wide, but collapsing it would
   // merge the valence-3 corners pairwise into valence-2 nodes (a degenerate pillow), so the
   // valence rule keeps the 8-corner layout.
-  PolyMesh box;
-  std::map<std::array<int, 3>, VH> lattice;
-  const std::array<int, 3> size{6, 6, 1};
-  auto vertex = [&](std::array<int, 3> p) {
-    auto it = lattice.find(p);
-    if (it != lattice.end()) return it->second;
-    const VH v = box.add_vertex(Vec3(p[0], p[1], p[2]));
-    lattice.emplace(p, v);
-    return v;
-  };
-  for (int axis = 0; axis < 3; ++axis) {
-    for (int side : {0, size[axis]}) {
-      int b = (axis + 1) % 3, c = (axis + 2) % 3;
-      if (side == 0) std::swap(b, c);
-      for (int i = 0; i < size[b]; ++i) {
-        for (int j = 0; j < size[c]; ++j) {
-          std::array<int, 3> p{};
-          p[axis] = side;
-          auto at = [&](int di, int dj) {
-            std::array<int, 3> q = p;
-            q[b] = i + di;
-            q[c] = j + dj;
-            return vertex(q);
-          };
-          box.add_face(std::vector<VH>{at(0, 0), at(1, 0), at(1, 1), at(0, 1)});
-        }
-      }
-    }
-  }
+  const PolyMesh box = test::quad_box({6, 6, 1});
   const QuadComplex full = base_complex(box);
   ASSERT_EQ(full.node_vertex.size(), 8u);
   CoarsenOptions options;

@@ -4,7 +4,6 @@
 
 #include <cmath>
 
-#include "core/layout/routing.h"
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_checks.h"
 #include "core/mesh/mesh_io.h"
@@ -29,29 +28,6 @@ Vec3 centroid(const TriMesh& mesh, const std::vector<int>& vertices) {
   Vec3 c(0, 0, 0);
   for (int v : vertices) c += mesh.point(mesh.vertex_handle(v));
   return c / static_cast<double>(vertices.size());
-}
-
-// One node with dangling arcs routed (disjoint shortest paths) to the given boundary vertices.
-Layout star_layout(const TriMesh& mesh, int center, const std::vector<int>& targets) {
-  Layout layout;
-  LayoutNode node;
-  node.id = 0;
-  node.vertex = center;
-  layout.nodes.push_back(node);
-  for (size_t i = 0; i < targets.size(); ++i) {
-    RoutingObstacles obstacles = obstacles_of_layout(mesh, layout);
-    // A dangling arc touches the boundary only at its end.
-    for (auto v : mesh.vertices())
-      if (mesh.is_boundary(v) && v.idx() != targets[i]) obstacles.vertex_blocked[v.idx()] = 1;
-    LayoutArc arc;
-    arc.id = static_cast<int>(i);
-    arc.from = 0;
-    arc.to = -1;
-    arc.path = shortest_path(mesh, center, targets[i], obstacles);
-    EXPECT_GE(arc.path.size(), 2u) << "could not route arc " << i;
-    layout.arcs.push_back(arc);
-  }
-  return layout;
 }
 
 // With \p aligned the field follows reliable curvature; its topology must still be the
@@ -93,7 +69,8 @@ TEST(Boundary, FaceWithFourDanglingArcs) {
   const auto& loop = loops[0];
   const int center = nearest_vertex(mesh, centroid(mesh, loop), true);
   const size_t q = loop.size() / 4;
-  const Layout layout = star_layout(mesh, center, {loop[0], loop[q], loop[2 * q], loop[3 * q]});
+  const Layout layout =
+      test::dangling_star_layout(mesh, center, {loop[0], loop[q], loop[2 * q], loop[3 * q]});
   expect_embedding(mesh, layout, 4, /*aligned=*/false);
   expect_embedding(mesh, layout, 4, /*aligned=*/true);
 }
@@ -102,36 +79,10 @@ TEST(Boundary, MaskWithArcsIntoBothEyes) {
   const std::string dir = test::shared_meshes_dir();
   if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes is absent (real-mesh test)";
   const TriMesh mesh = load_mesh(dir + "/mask_confmap.obj");
-  auto loops = boundary_loops(mesh);
-  ASSERT_EQ(loops.size(), 3u);
-  std::sort(loops.begin(), loops.end(),
-            [](const auto& a, const auto& b) { return a.size() > b.size(); });
-  const auto& outer = loops[0];
-  const Vec3 eye_a = centroid(mesh, loops[1]), eye_b = centroid(mesh, loops[2]);
-  const int center = nearest_vertex(mesh, 0.5 * (eye_a + eye_b), true);
-  // Targets: the nearest vertex of each eye, and the two outer-boundary vertices farthest
-  // from the eye axis on either side.
-  auto nearest_on = [&](const std::vector<int>& loop, const Vec3& p) {
-    int best = loop[0];
-    for (int v : loop)
-      if ((mesh.point(mesh.vertex_handle(v)) - p).sqrnorm() <
-          (mesh.point(mesh.vertex_handle(best)) - p).sqrnorm())
-        best = v;
-    return best;
-  };
-  const Vec3 c = mesh.point(mesh.vertex_handle(center));
-  Vec3 normal(0, 0, 0);
-  for (auto f : mesh.faces()) normal += mesh.calc_face_normal(f) * mesh.calc_face_area(f);
-  const Vec3 up_dir = (normal % (eye_b - eye_a)).normalized();
-  int up = outer[0], down = outer[0];
-  for (int v : outer) {
-    const double s = (mesh.point(mesh.vertex_handle(v)) - c) | up_dir;
-    if (s > ((mesh.point(mesh.vertex_handle(up)) - c) | up_dir)) up = v;
-    if (s < ((mesh.point(mesh.vertex_handle(down)) - c) | up_dir)) down = v;
-  }
-  ASSERT_NE(up, down);
-  const Layout layout =
-      star_layout(mesh, center, {nearest_on(loops[1], c), up, nearest_on(loops[2], c), down});
+  const test::MaskStar star = test::mask_star(mesh);
+  ASSERT_EQ(star.boundary_loops, 3u);
+  ASSERT_NE(star.targets[1], star.targets[3]);  // up, down
+  const Layout layout = test::dangling_star_layout(mesh, star.center, star.targets);
   // Free eye holes: a few faces fold where the iso-lines wrap around them (issue #4 note).
   expect_embedding(mesh, layout, 2, /*aligned=*/false, 0.05);
   expect_embedding(mesh, layout, 2, /*aligned=*/true);

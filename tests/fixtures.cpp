@@ -1,8 +1,10 @@
 #include "tests/fixtures.h"
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -10,6 +12,9 @@
 #include <fstream>
 #include <map>
 #include <set>
+
+#include "core/layout/routing.h"
+#include "core/mesh/mesh_checks.h"
 
 namespace qs::test {
 
@@ -300,7 +305,148 @@ MeshAndLayout genus2_polycube(int k) {
   return voxel_surface(voxels, k);
 }
 
-void write_obj(const TriMesh& mesh, const std::string& path) {
+PolyMesh quad_box(std::array<int, 3> size, Vec3 offset) {
+  using VH = OpenMesh::VertexHandle;
+  PolyMesh mesh;
+  std::map<std::array<int, 3>, VH> lattice;
+  auto vertex = [&](std::array<int, 3> p) {
+    auto it = lattice.find(p);
+    if (it != lattice.end()) return it->second;
+    const VH v = mesh.add_vertex(Vec3(p[0], p[1], p[2]) + offset);
+    lattice.emplace(p, v);
+    return v;
+  };
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int side : {0, size[axis]}) {
+      // Tangent axes (b, c) with b × c = +axis; swapped on the negative side.
+      int b = (axis + 1) % 3, c = (axis + 2) % 3;
+      if (side == 0) std::swap(b, c);
+      for (int i = 0; i < size[b]; ++i) {
+        for (int j = 0; j < size[c]; ++j) {
+          std::array<int, 3> p{};
+          p[axis] = side;
+          auto at = [&](int di, int dj) {
+            std::array<int, 3> q = p;
+            q[b] = i + di;
+            q[c] = j + dj;
+            return vertex(q);
+          };
+          mesh.add_face(std::vector<VH>{at(0, 0), at(1, 0), at(1, 1), at(0, 1)});
+        }
+      }
+    }
+  }
+  return mesh;
+}
+
+PolyMesh quad_cube(int k, Vec3 offset) {
+  return quad_box({k, k, k}, offset);
+}
+
+PolyMesh quad_torus(int nu, int nv) {
+  using VH = OpenMesh::VertexHandle;
+  PolyMesh mesh;
+  for (int i = 0; i < nu; ++i) {
+    for (int j = 0; j < nv; ++j) {
+      const double t = 2 * M_PI * i / nu, f = 2 * M_PI * j / nv;
+      mesh.add_vertex(Vec3((2 + 0.7 * std::cos(f)) * std::cos(t),
+                           (2 + 0.7 * std::cos(f)) * std::sin(t), 0.7 * std::sin(f)));
+    }
+  }
+  auto id = [&](int i, int j) { return VH(((i + nu) % nu) * nv + (j + nv) % nv); };
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j)
+      mesh.add_face(std::vector<VH>{id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+  return mesh;
+}
+
+PolyMesh quad_disk(int nx, int ny) {
+  using VH = OpenMesh::VertexHandle;
+  PolyMesh mesh;
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) mesh.add_vertex(Vec3(i, j, 0));
+  auto id = [&](int i, int j) { return VH(j * (nx + 1) + i); };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i)
+      mesh.add_face(std::vector<VH>{id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+  return mesh;
+}
+
+PolyMesh notched_disk(int n) {
+  using VH = OpenMesh::VertexHandle;
+  PolyMesh mesh;
+  std::map<std::array<int, 2>, VH> ids;
+  auto at = [&](int i, int j) {
+    auto it = ids.find({i, j});
+    if (it != ids.end()) return it->second;
+    const VH v = mesh.add_vertex(Vec3(i, j, 0));
+    ids.emplace(std::array<int, 2>{i, j}, v);
+    return v;
+  };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      if (i != n - 1 || j != n - 1)
+        mesh.add_face(std::vector<VH>{at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+  return mesh;
+}
+
+Layout dangling_star_layout(const TriMesh& mesh, int center, const std::vector<int>& targets) {
+  Layout layout;
+  layout.nodes.push_back(make_node(0, center));
+  for (size_t i = 0; i < targets.size(); ++i) {
+    RoutingObstacles obstacles = obstacles_of_layout(mesh, layout);
+    // A dangling arc touches the boundary only at its end.
+    for (auto v : mesh.vertices())
+      if (mesh.is_boundary(v) && v.idx() != targets[i]) obstacles.vertex_blocked[v.idx()] = 1;
+    LayoutArc arc =
+        make_arc(static_cast<int>(i), 0, -1, shortest_path(mesh, center, targets[i], obstacles));
+    EXPECT_GE(arc.path.size(), 2u) << "could not route arc " << i;
+    layout.arcs.push_back(std::move(arc));
+  }
+  return layout;
+}
+
+MaskStar mask_star(const TriMesh& mesh) {
+  MaskStar star;
+  auto loops = boundary_loops(mesh);
+  star.boundary_loops = loops.size();
+  if (loops.size() != 3) return star;
+  std::sort(loops.begin(), loops.end(),
+            [](const auto& a, const auto& b) { return a.size() > b.size(); });
+  auto point = [&](int v) { return mesh.point(mesh.vertex_handle(v)); };
+  auto centroid = [&](const std::vector<int>& vs) {
+    Vec3 c(0, 0, 0);
+    for (int v : vs) c += point(v);
+    return c / static_cast<double>(vs.size());
+  };
+  auto nearest = [&](const std::vector<int>& candidates, const Vec3& p) {
+    int best = candidates[0];
+    for (int v : candidates)
+      if ((point(v) - p).sqrnorm() < (point(best) - p).sqrnorm()) best = v;
+    return best;
+  };
+  const Vec3 eye_a = centroid(loops[1]), eye_b = centroid(loops[2]);
+  std::vector<int> interior;
+  for (auto v : mesh.vertices())
+    if (!mesh.is_boundary(v)) interior.push_back(v.idx());
+  star.center = nearest(interior, 0.5 * (eye_a + eye_b));
+  const Vec3 c = point(star.center);
+  Vec3 normal(0, 0, 0);
+  for (auto f : mesh.faces()) normal += mesh.calc_face_normal(f) * mesh.calc_face_area(f);
+  const Vec3 up_dir = (normal % (eye_b - eye_a)).normalized();
+  int up = loops[0][0], down = loops[0][0];
+  for (int v : loops[0]) {
+    if (((point(v) - c) | up_dir) > ((point(up) - c) | up_dir)) up = v;
+    if (((point(v) - c) | up_dir) < ((point(down) - c) | up_dir)) down = v;
+  }
+  star.targets = {nearest(loops[1], c), up, nearest(loops[2], c), down};
+  return star;
+}
+
+namespace {
+
+template <class Mesh>
+void write_obj_text(const Mesh& mesh, const std::string& path) {
   std::ofstream out(path);
   out.precision(17);
   for (auto v : mesh.vertices()) {
@@ -312,6 +458,16 @@ void write_obj(const TriMesh& mesh, const std::string& path) {
     for (auto v : mesh.fv_range(f)) out << ' ' << v.idx() + 1;
     out << '\n';
   }
+}
+
+}  // namespace
+
+void write_obj(const TriMesh& mesh, const std::string& path) {
+  write_obj_text(mesh, path);
+}
+
+void write_obj(const PolyMesh& mesh, const std::string& path) {
+  write_obj_text(mesh, path);
 }
 
 }  // namespace qs::test

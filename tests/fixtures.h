@@ -1,7 +1,9 @@
 // Synthetic meshes and layouts for tests (algorithm.md §10), plus paths to test data.
 #pragma once
 
+#include <array>
 #include <string>
+#include <vector>
 
 #include "core/layout/layout.h"
 #include "core/mesh/mesh.h"
@@ -50,7 +52,47 @@ MeshAndLayout voxel_surface(const std::vector<std::array<int, 3>>& voxels, int k
 //! columns (nodes of valence 3, 4 and 5).
 MeshAndLayout genus2_polycube(int k);
 
+//! Surface of the box [0,sx]×[0,sy]×[0,sz] (size {sx, sy, sz}) as a unit quad grid per side,
+//! outward oriented, shifted by \p offset.
+PolyMesh quad_box(std::array<int, 3> size, Vec3 offset = Vec3(0, 0, 0));
+
+//! Surface of the cube [0,k]^3 as a k×k quad grid per side, outward oriented, shifted by
+//! \p offset (quad_box with size {k, k, k}).
+PolyMesh quad_cube(int k, Vec3 offset = Vec3(0, 0, 0));
+
+//! nu × nv quad grid on a torus (radii 2 and 0.7; no irregular vertex).
+PolyMesh quad_torus(int nu, int nv);
+
+//! Flat nx × ny quad grid [0,nx]×[0,ny] (a disk); its 4 corners have valence 2.
+PolyMesh quad_disk(int nx, int ny);
+
+//! Flat n × n quad grid without its top-right cell: a disk with one concave corner whose two
+//! separatrices cut thin strips (one cell wide) off the top and right sides.
+PolyMesh notched_disk(int n);
+
+//! A layout of one node at \p center with one dangling arc (to = -1) per target boundary vertex,
+//! routed in order as shortest paths that avoid the arcs before them and touch the boundary
+//! only at their end. An arc that cannot be routed is kept with its (short) path and reported
+//! as a non-fatal test failure.
+Layout dangling_star_layout(const TriMesh& mesh, int center, const std::vector<int>& targets);
+
+//! Node and dangling-arc targets of a star on a mesh with three boundary loops, like
+//! mask_confmap.obj (a face with two eye holes), for dangling_star_layout.
+struct MaskStar {
+  size_t boundary_loops = 0;  //!< number of boundary loops of the mesh (the star needs 3)
+  int center = -1;            //!< interior vertex nearest to the midpoint of the eye centroids
+  std::vector<int> targets;   //!< eye 1 (nearest to center), up, eye 2 (nearest), down
+};
+
+//! The star of MaskStar on \p mesh (center and targets left unset unless it has three boundary
+//! loops). Loops sorted largest first: the outer boundary, then the eyes. Up and down are the
+//! outer-boundary vertices farthest from the center on either side of the eye axis (with the
+//! area-weighted mesh normal).
+MaskStar mask_star(const TriMesh& mesh);
+
 //! Writes a mesh as OBJ text (full precision) — for fixtures only.
 void write_obj(const TriMesh& mesh, const std::string& path);
+//! The same for a polygon mesh (one `f` line per face, any number of corners).
+void write_obj(const PolyMesh& mesh, const std::string& path);
 
 }  // namespace qs::test

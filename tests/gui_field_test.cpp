@@ -3,13 +3,10 @@
 // GL-free). With the render library linked (QS_TEST_RENDER), also the glyph subsampling.
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cmath>
-#include <filesystem>
 
 #include "app/gui/pipeline_job.h"
-#include "core/layout/layout_io.h"
-#include "core/mesh/mesh_io.h"
+#include "tests/gui_job_fixture.h"
 #ifdef QS_TEST_RENDER
 #include "render/field_layer.h"
 #endif
@@ -17,35 +14,15 @@
 namespace qs::app {
 namespace {
 
-using namespace std::chrono_literals;
-namespace fs = std::filesystem;
-
-struct Example {
-  std::shared_ptr<const TriMesh> mesh;
-  Layout layout;
-};
-
-Example example() {
-  const fs::path dir = fs::path(QS_ASSETS_DIR) / "example";
-  auto mesh = std::make_shared<TriMesh>(load_mesh((dir / "ellipsoid.obj").string()));
-  Layout layout = load_layout((dir / "ellipsoid.layout.json").string(), *mesh);
-  return {mesh, std::move(layout)};
-}
+using test::Example;
+using test::example;
 
 // The initial solve only (no node optimization) with the given options.
 SnapshotPtr solve_once(const Example& ex, WorkerOptions options) {
-  Worker worker(pipeline_step);
   options.max_steps = 1;
   options.node_optimization = false;
   options.publish_interval_ms = 0;
-  worker.send(cmd::SetOptions{options});
-  worker.send(cmd::LoadMesh{ex.mesh, ex.layout});
-  worker.send(cmd::Run{});
-  return worker.wait_for(
-      [](const Snapshot& x) {
-        return x.status == WorkerStatus::Finished || x.status == WorkerStatus::Failed;
-      },
-      120s);
+  return test::run_job(ex, options);
 }
 
 int count_kind(const FieldView& field, int kind) {

@@ -2,49 +2,36 @@
 // timings and node positions per step, the quad mesh at the final step, and the exports.
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 
 #include "app/gui/history.h"
 #include "app/gui/pipeline_job.h"
 #include "core/layout/layout_io.h"
-#include "core/mesh/mesh_io.h"
 #include "core/nodeopt/optimizer.h"
 #include "core/pipeline/pipeline.h"
+#include "tests/gui_job_fixture.h"
 
 namespace qs::app {
 namespace {
 
-using namespace std::chrono_literals;
 namespace fs = std::filesystem;
 
-struct Example {
-  std::shared_ptr<const TriMesh> mesh;
-  Layout layout;
-};
+using test::Example;
+using test::example;
 
-Example example() {
-  const fs::path dir = fs::path(QS_ASSETS_DIR) / "example";
-  auto mesh = std::make_shared<TriMesh>(load_mesh((dir / "ellipsoid.obj").string()));
-  Layout layout = load_layout((dir / "ellipsoid.layout.json").string(), *mesh);
-  return {mesh, std::move(layout)};
+//! Options of a run of \p max_steps steps that publishes every step.
+WorkerOptions steps(int max_steps) {
+  WorkerOptions options;
+  options.max_steps = max_steps;
+  options.publish_interval_ms = 0;
+  return options;
 }
 
 TEST(GuiJob, StreamsMetricsHistoryQuadsAndExports) {
   const Example ex = example();
-  Worker worker(pipeline_step);
-  WorkerOptions options;
-  options.max_steps = 2;  // initial solve + one node-optimization step
-  options.publish_interval_ms = 0;
-  worker.send(cmd::SetOptions{options});
-  worker.send(cmd::LoadMesh{ex.mesh, ex.layout});
-  worker.send(cmd::Run{});
-  const auto s = worker.wait_for(
-      [](const Snapshot& x) {
-        return x.status == WorkerStatus::Finished || x.status == WorkerStatus::Failed;
-      },
-      120s);
+  const WorkerOptions options = steps(2);  // initial solve + one node-optimization step
+  const auto s = test::run_job(ex, options);
   ASSERT_EQ(s->status, WorkerStatus::Finished) << s->message;
   ASSERT_EQ(s->iteration, 2);
 
@@ -108,18 +95,8 @@ TEST(GuiJob, ExportWithoutQuadMeshFailsClearly) {
 // its energy is the one of a Pipeline built from scratch on the step's mesh and layout.
 TEST(GuiJob, DisplayedStepMatchesFreshSolve) {
   const Example ex = example();
-  Worker worker(pipeline_step);
-  WorkerOptions options;
-  options.max_steps = 3;  // initial solve + two node-optimization steps
-  options.publish_interval_ms = 0;
-  worker.send(cmd::SetOptions{options});
-  worker.send(cmd::LoadMesh{ex.mesh, ex.layout});
-  worker.send(cmd::Run{});
-  const auto s = worker.wait_for(
-      [](const Snapshot& x) {
-        return x.status == WorkerStatus::Finished || x.status == WorkerStatus::Failed;
-      },
-      120s);
+  const WorkerOptions options = steps(3);  // initial solve + two node-optimization steps
+  const auto s = test::run_job(ex, options);
   ASSERT_EQ(s->status, WorkerStatus::Finished) << s->message;
   ASSERT_TRUE(s->exports);
   Layout layout = s->exports->layout;

@@ -17,7 +17,6 @@
 #include "core/layout/layout_io.h"
 #include "core/layout/perturb.h"
 #include "core/layout/quad_import.h"
-#include "core/layout/routing.h"
 #include "core/mesh/mesh_checks.h"
 #include "core/mesh/mesh_io.h"
 #include "core/nodeopt/gradient.h"
@@ -385,53 +384,10 @@ TEST(OrientationRealData, InfeasibleConstraintsOnMaskKeepTheSolveAndSayWhy) {
   const std::string dir = test::shared_meshes_dir();
   if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
   const TriMesh mesh = load_mesh(dir + "/mask_confmap.obj");
-  auto loops = boundary_loops(mesh);
-  ASSERT_EQ(loops.size(), 3u);
-  std::sort(loops.begin(), loops.end(),
-            [](const auto& a, const auto& b) { return a.size() > b.size(); });
-  auto point = [&](int v) { return mesh.point(mesh.vertex_handle(v)); };
-  auto centroid = [&](const std::vector<int>& vs) {
-    Vec3 c(0, 0, 0);
-    for (int v : vs) c += point(v);
-    return c / static_cast<double>(vs.size());
-  };
-  auto nearest = [&](const std::vector<int>& candidates, const Vec3& p) {
-    int best = candidates[0];
-    for (int v : candidates)
-      if ((point(v) - p).sqrnorm() < (point(best) - p).sqrnorm()) best = v;
-    return best;
-  };
-  const Vec3 eye_a = centroid(loops[1]), eye_b = centroid(loops[2]);
-  std::vector<int> interior;
-  for (auto v : mesh.vertices())
-    if (!mesh.is_boundary(v)) interior.push_back(v.idx());
-  const int center = nearest(interior, 0.5 * (eye_a + eye_b));
-  Vec3 normal(0, 0, 0);
-  for (auto f : mesh.faces()) normal += mesh.calc_face_normal(f) * mesh.calc_face_area(f);
-  const Vec3 up_dir = (normal % (eye_b - eye_a)).normalized();
-  int up = loops[0][0], down = loops[0][0];
-  for (int v : loops[0]) {
-    if (((point(v) - point(center)) | up_dir) > ((point(up) - point(center)) | up_dir)) up = v;
-    if (((point(v) - point(center)) | up_dir) < ((point(down) - point(center)) | up_dir)) down = v;
-  }
-  Layout layout;
-  layout.nodes.push_back(LayoutNode{});
-  layout.nodes[0].id = 0;
-  layout.nodes[0].vertex = center;
-  const std::vector<int> targets = {nearest(loops[1], point(center)), up,
-                                    nearest(loops[2], point(center)), down};
-  for (size_t i = 0; i < targets.size(); ++i) {
-    RoutingObstacles obstacles = obstacles_of_layout(mesh, layout);
-    for (auto v : mesh.vertices())
-      if (mesh.is_boundary(v) && v.idx() != targets[i]) obstacles.vertex_blocked[v.idx()] = 1;
-    LayoutArc arc;
-    arc.id = static_cast<int>(i);
-    arc.from = 0;
-    arc.to = -1;
-    arc.path = shortest_path(mesh, center, targets[i], obstacles);
-    ASSERT_GE(arc.path.size(), 2u);
-    layout.arcs.push_back(arc);
-  }
+  const test::MaskStar star = test::mask_star(mesh);
+  ASSERT_EQ(star.boundary_loops, 3u);
+  const Layout layout = test::dangling_star_layout(mesh, star.center, star.targets);
+  for (const LayoutArc& arc : layout.arcs) ASSERT_GE(arc.path.size(), 2u);
   PipelineOptions options;
   options.field.constraints.curvature = false;
   Pipeline plain(mesh, layout, options);

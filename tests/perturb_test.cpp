@@ -4,9 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <array>
 #include <filesystem>
-#include <map>
 
 #include "core/base/atomic_file.h"
 #include "core/base/errors.h"
@@ -20,39 +18,7 @@ namespace qs {
 namespace {
 
 using VH = OpenMesh::VertexHandle;
-
-//! Surface of the cube [0,k]^3 as a k×k quad grid per side, outward oriented.
-PolyMesh quad_cube(int k) {
-  PolyMesh mesh;
-  std::map<std::array<int, 3>, VH> lattice;
-  auto vertex = [&](std::array<int, 3> p) {
-    auto it = lattice.find(p);
-    if (it != lattice.end()) return it->second;
-    const VH v = mesh.add_vertex(Vec3(p[0], p[1], p[2]));
-    lattice.emplace(p, v);
-    return v;
-  };
-  for (int axis = 0; axis < 3; ++axis) {
-    for (int side : {0, k}) {
-      int b = (axis + 1) % 3, c = (axis + 2) % 3;
-      if (side == 0) std::swap(b, c);
-      for (int i = 0; i < k; ++i) {
-        for (int j = 0; j < k; ++j) {
-          std::array<int, 3> p{};
-          p[axis] = side;
-          auto at = [&](int di, int dj) {
-            std::array<int, 3> q = p;
-            q[b] = i + di;
-            q[c] = j + dj;
-            return vertex(q);
-          };
-          mesh.add_face(std::vector<VH>{at(0, 0), at(1, 0), at(1, 1), at(0, 1)});
-        }
-      }
-    }
-  }
-  return mesh;
-}
+using test::quad_cube;
 
 //! Breadth-first edge distance between two vertices.
 int ring_distance(const TriMesh& mesh, int a, int b) {

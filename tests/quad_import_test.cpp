@@ -4,10 +4,8 @@
 
 #include <gtest/gtest.h>
 
-#include <array>
 #include <filesystem>
 #include <fstream>
-#include <map>
 
 #include "core/base/errors.h"
 #include "core/layout/validate.h"
@@ -19,88 +17,9 @@ namespace qs {
 namespace {
 
 using VH = OpenMesh::VertexHandle;
-
-//! Surface of the cube [0,k]^3 as a k×k quad grid per side, outward oriented.
-PolyMesh quad_cube(int k, Vec3 offset = Vec3(0, 0, 0)) {
-  PolyMesh mesh;
-  std::map<std::array<int, 3>, VH> lattice;
-  auto vertex = [&](std::array<int, 3> p) {
-    auto it = lattice.find(p);
-    if (it != lattice.end()) return it->second;
-    const VH v = mesh.add_vertex(Vec3(p[0], p[1], p[2]) + offset);
-    lattice.emplace(p, v);
-    return v;
-  };
-  for (int axis = 0; axis < 3; ++axis) {
-    for (int side : {0, k}) {
-      int b = (axis + 1) % 3, c = (axis + 2) % 3;
-      if (side == 0) std::swap(b, c);
-      for (int i = 0; i < k; ++i) {
-        for (int j = 0; j < k; ++j) {
-          std::array<int, 3> p{};
-          p[axis] = side;
-          auto at = [&](int di, int dj) {
-            std::array<int, 3> q = p;
-            q[b] = i + di;
-            q[c] = j + dj;
-            return vertex(q);
-          };
-          mesh.add_face(std::vector<VH>{at(0, 0), at(1, 0), at(1, 1), at(0, 1)});
-        }
-      }
-    }
-  }
-  return mesh;
-}
-
-//! nu × nv quad grid on a torus (no irregular vertex).
-PolyMesh quad_torus(int nu, int nv) {
-  PolyMesh mesh;
-  for (int i = 0; i < nu; ++i) {
-    for (int j = 0; j < nv; ++j) {
-      const double t = 2 * M_PI * i / nu, f = 2 * M_PI * j / nv;
-      mesh.add_vertex(Vec3((2 + 0.7 * std::cos(f)) * std::cos(t),
-                           (2 + 0.7 * std::cos(f)) * std::sin(t), 0.7 * std::sin(f)));
-    }
-  }
-  auto id = [&](int i, int j) { return VH(((i + nu) % nu) * nv + (j + nv) % nv); };
-  for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j)
-      mesh.add_face(std::vector<VH>{id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
-  return mesh;
-}
-
-//! Flat n × n quad grid without its top-right cell (two one-cell strips in its base complex).
-PolyMesh notched_disk(int n) {
-  PolyMesh mesh;
-  std::map<std::array<int, 2>, VH> ids;
-  auto at = [&](int i, int j) {
-    auto it = ids.find({i, j});
-    if (it != ids.end()) return it->second;
-    const VH v = mesh.add_vertex(Vec3(i, j, 0));
-    ids.emplace(std::array<int, 2>{i, j}, v);
-    return v;
-  };
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i)
-      if (i != n - 1 || j != n - 1)
-        mesh.add_face(std::vector<VH>{at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
-  return mesh;
-}
-
-void write_poly_obj(const PolyMesh& mesh, const std::string& path) {
-  std::ofstream out(path);
-  out.precision(17);
-  for (const auto v : mesh.vertices()) {
-    const Vec3& p = mesh.point(v);
-    out << "v " << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
-  }
-  for (const auto f : mesh.faces()) {
-    out << 'f';
-    for (const auto v : mesh.fv_range(f)) out << ' ' << v.idx() + 1;
-    out << '\n';
-  }
-}
+using test::notched_disk;
+using test::quad_cube;
+using test::quad_torus;
 
 //! Checks that an import validates and has the complex's patch count and node valences.
 void expect_matches_complex(const QuadImportResult& r, const std::string& what) {
@@ -209,7 +128,7 @@ TEST(QuadImport, FarFromTargetIsAnError) {
 
 TEST(QuadImportCli, WritesMeshAndLayoutAndRejectsBadInput) {
   const std::string dir = test::temp_dir("import_quads_cli");
-  write_poly_obj(quad_cube(2), dir + "/cube.obj");
+  test::write_obj(quad_cube(2), dir + "/cube.obj");
   std::string output;
   const std::string out = dir + "/out";
   ASSERT_EQ(test::run_command(test::cli_path() + " import-quads --quads " + dir +
@@ -241,7 +160,7 @@ TEST(QuadImportCli, WritesMeshAndLayoutAndRejectsBadInput) {
   EXPECT_NE(output.find("nonmanifold.obj"), std::string::npos) << output;
 
   // A quad mesh far from the --onto surface.
-  write_poly_obj(quad_cube(2, Vec3(100, 0, 0)), dir + "/far.obj");
+  test::write_obj(quad_cube(2, Vec3(100, 0, 0)), dir + "/far.obj");
   test::write_obj(triangulate_quads(quad_cube(2), 2), dir + "/target.obj");
   EXPECT_EQ(test::run_command(test::cli_path() + " import-quads --quads " + dir +
                                   "/far.obj --onto " + dir + "/target.obj --out " + dir + "/bad2",
