@@ -71,6 +71,8 @@ TEST(Boundary, FaceWithFourDanglingArcs) {
   const size_t q = loop.size() / 4;
   const Layout layout =
       test::dangling_star_layout(mesh, center, {loop[0], loop[q], loop[2 * q], loop[3 * q]});
+  for (size_t i = 0; i < layout.arcs.size(); ++i)
+    EXPECT_GE(layout.arcs[i].path.size(), 2u) << "could not route arc " << i;
   expect_embedding(mesh, layout, 4, /*aligned=*/false);
   expect_embedding(mesh, layout, 4, /*aligned=*/true);
 }
@@ -83,6 +85,8 @@ TEST(Boundary, MaskWithArcsIntoBothEyes) {
   ASSERT_EQ(star.boundary_loops, 3u);
   ASSERT_NE(star.targets[1], star.targets[3]);  // up, down
   const Layout layout = test::dangling_star_layout(mesh, star.center, star.targets);
+  for (size_t i = 0; i < layout.arcs.size(); ++i)
+    EXPECT_GE(layout.arcs[i].path.size(), 2u) << "could not route arc " << i;
   // Free eye holes: a few faces fold where the iso-lines wrap around them (issue #4 note).
   expect_embedding(mesh, layout, 2, /*aligned=*/false, 0.05);
   expect_embedding(mesh, layout, 2, /*aligned=*/true);

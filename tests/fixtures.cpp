@@ -1,6 +1,5 @@
 #include "tests/fixtures.h"
 
-#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -400,7 +399,6 @@ Layout dangling_star_layout(const TriMesh& mesh, int center, const std::vector<i
       if (mesh.is_boundary(v) && v.idx() != targets[i]) obstacles.vertex_blocked[v.idx()] = 1;
     LayoutArc arc =
         make_arc(static_cast<int>(i), 0, -1, shortest_path(mesh, center, targets[i], obstacles));
-    EXPECT_GE(arc.path.size(), 2u) << "could not route arc " << i;
     layout.arcs.push_back(std::move(arc));
   }
   return layout;

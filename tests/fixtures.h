@@ -72,8 +72,9 @@ PolyMesh notched_disk(int n);
 
 //! A layout of one node at \p center with one dangling arc (to = -1) per target boundary vertex,
 //! routed in order as shortest paths that avoid the arcs before them and touch the boundary
-//! only at their end. An arc that cannot be routed is kept with its (short) path and reported
-//! as a non-fatal test failure.
+//! only at their end. An arc that cannot be routed is kept with its (short) path: callers check
+//! that every path has at least 2 vertices (this file is also linked into the benchmarks, so it
+//! does not use GoogleTest).
 Layout dangling_star_layout(const TriMesh& mesh, int center, const std::vector<int>& targets);
 
 //! Node and dangling-arc targets of a star on a mesh with three boundary loops, like

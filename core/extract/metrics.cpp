@@ -9,7 +9,7 @@ ParamMetrics compute_metrics(const TriMesh& mesh, const GeometryCache& g, const 
                              const std::vector<std::array<double, 2>>& uv, double energy) {
   ParamMetrics m;
   m.E = energy;
-  double area_sum = 0, confor = 0, angle_num = 0, angle_den = 0, planar = 0;
+  double area_sum = 0, confor = 0, confor_area = 0, angle_num = 0, angle_den = 0, planar = 0;
   auto deviation_deg = [](const Eigen::Vector2d& v, const Eigen::Vector2d& d) {
     const double a = std::atan2(v.y(), v.x()) - std::atan2(d.y(), d.x());
     return std::abs(std::remainder(a, M_PI / 2)) * 180.0 / M_PI;
@@ -27,12 +27,18 @@ ParamMetrics compute_metrics(const TriMesh& mesh, const GeometryCache& g, const 
     area_sum += a;
     if (Euv.determinant() <= 0) ++m.foldovers;
     if (std::abs(E3.determinant()) < 1e-300) continue;
-    const Eigen::Matrix2d J = Euv * E3.inverse();  // rows: ∇u, ∇v
-    const Eigen::Vector2d sv = J.jacobiSvd().singularValues();
-    if (sv(1) > 0)
+    if (!Euv.allFinite()) {  // a failed solve: no meaningful term for this face
+      ++m.degenerate;
+      continue;
+    }
+    const Eigen::Matrix2d J = Euv * E3.inverse();               // rows: ∇u, ∇v
+    const Eigen::Vector2d sv = J.jacobiSvd().singularValues();  // sv(0) ≥ sv(1) ≥ 0
+    if (!(sv(1) > ParamMetrics::kDegenerateRatio * sv(0))) {
+      ++m.degenerate;  // collapsed image: σ1/σ2 is unbounded
+    } else {
       confor += a * (sv(0) / sv(1) + sv(1) / sv(0));
-    else
-      confor += a * 1e6;
+      confor_area += a;
+    }
     const Eigen::Vector2d gu = J.row(0).transpose(), gv = J.row(1).transpose();
     const Vec3& d1 = curv.dir_max[f];
     const Vec3& r = g.face_frame[f];
@@ -47,7 +53,7 @@ ParamMetrics compute_metrics(const TriMesh& mesh, const GeometryCache& g, const 
       planar += a * std::abs(gu.normalized().dot(S * gv.normalized()));
   }
   if (area_sum > 0) {
-    m.E_confor = confor / area_sum;
+    m.E_confor = confor_area > 0 ? confor / confor_area : 0.0;
     m.E_planar = planar / std::sqrt(area_sum);
   }
   m.E_angle_deg = angle_den > 0 ? angle_num / angle_den : 0.0;

@@ -38,7 +38,8 @@ class Tracer {
     V2 dir = rotate(symbol, V2{1.0, 0.0});
     int face = chart_face;
     if (!find_sector(start_vertex, face, dir))
-      return fail(out, "no start sector at vertex " + std::to_string(start_vertex));
+      return fail(out, "no start sector at vertex " + std::to_string(start_vertex) +
+                           fold_note(start_vertex));
     add_vertex_sample(out, face, start_vertex);
     V2 point = at(face, start_vertex);
     int at_vertex = start_vertex;
@@ -79,8 +80,9 @@ class Tracer {
         if (prog > best) best = prog, best_edge = k, best_t = t, best_vertex = -1;
       }
       if (best_vertex < 0 && best_edge < 0)
-        return fail(out,
-                    "stuck in face " + std::to_string(face) + " (fold-over or degenerate chart)");
+        return fail(out, "stuck in face " + std::to_string(face) +
+                             (folded(face) ? " (folded in the parameterization)"
+                                           : " (fold-over or degenerate chart)"));
       out.param_length += best;
       if (best_vertex >= 0) {
         const int w = fv[best_vertex];
@@ -92,7 +94,7 @@ class Tracer {
             return out;
           }
           return fail(out, "runs into node " + std::to_string(node_at_[w]) + " (vertex " +
-                               std::to_string(w) + ")");
+                               std::to_string(w) + ")" + fold_note(start_vertex));
         }
         if (mesh_.is_boundary(mesh_.vertex_handle(w)) && end_node < 0) {
           out.ok = true;
@@ -101,7 +103,7 @@ class Tracer {
         at_vertex = w;
         entry = HH();
         if (!find_sector(w, face, dir))
-          return fail(out, "no continuation at vertex " + std::to_string(w));
+          return fail(out, "no continuation at vertex " + std::to_string(w) + fold_note(w));
         point = at(face, w);
         continue;
       }
@@ -134,6 +136,22 @@ class Tracer {
 
  private:
   V2 at(int f, int v) const { return uv_[3 * f + corner_of(g_, f, v)]; }
+
+  bool folded(int f) const {
+    const V2 a = sub(uv_[3 * f + 1], uv_[3 * f]), b = sub(uv_[3 * f + 2], uv_[3 * f]);
+    return !(cross(a, b) > 0);
+  }
+
+  // " (face F at vertex w is folded …)" when a face around vertex w is folded: the arc's
+  // sector has no consistent chart there, so no tracer can leave the node correctly. Every
+  // failure seen on real inputs (spot, fandisk with --no-node-opt) had such a fold.
+  std::string fold_note(int w) const {
+    for (auto f : mesh_.vf_range(mesh_.vertex_handle(w)))
+      if (folded(f.idx()))
+        return " (face " + std::to_string(f.idx()) + " at vertex " + std::to_string(w) +
+               " is folded in the parameterization)";
+    return "";
+  }
 
   TracedArc& fail(TracedArc& out, std::string why) {
     out.ok = false;
@@ -305,6 +323,30 @@ Extraction extract_layout(const TriMesh& mesh, const GeometryCache& g, const Lay
   bool all_ok = true;
   for (const auto& t : ex.arcs) all_ok &= t.ok;
   ex.structurally_equivalent = all_ok && ex.crossings == 0;
+  // Parametric cone angle at every interior node.
+  std::vector<std::string> cone_problems;
+  for (int n = 0; n < topo.num_nodes; ++n) {
+    const int w = layout.nodes[n].vertex;
+    if (g.vertex_on_boundary[w]) continue;
+    double cone = 0;
+    for (auto f : mesh.vf_range(mesh.vertex_handle(w))) {
+      const int k = corner_of(g, f.idx(), w);
+      const V2 W = uv[3 * f.idx() + k];
+      const V2 a = sub(uv[3 * f.idx() + (k + 1) % 3], W), b = sub(uv[3 * f.idx() + (k + 2) % 3], W);
+      cone += std::atan2(cross(a, b), dot(a, b));
+    }
+    const double expected = topo.valence[n] * M_PI / 2;
+    if (!(std::abs(cone - expected) <= M_PI / 4)) {
+      ++ex.bad_cones;
+      cone_problems.push_back("node " + std::to_string(layout.nodes[n].id) + " (vertex " +
+                              std::to_string(w) + "): parametric cone angle " +
+                              std::to_string(std::lround(cone * 180 / M_PI)) + "° instead of " +
+                              std::to_string(90 * topo.valence[n]) + "°");
+    }
+  }
+  if (!ex.structurally_equivalent)
+    for (size_t i = 0; i < cone_problems.size() && i < 20; ++i)
+      ex.problems.push_back(cone_problems[i]);
   return ex;
 }
 

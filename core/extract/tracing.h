@@ -30,6 +30,12 @@ struct Extraction {
   int crossings = 0;  //!< pairs of traced arc segments crossing inside a face
   bool structurally_equivalent = false;
   std::vector<std::string> problems;  //!< why not equivalent
+  //! Interior nodes whose parametric cone angle (sum of the corner angles of the faces around
+  //! the node vertex, each in its own chart) differs from valence·90° by more than 45°: the
+  //! parameterization folds or winds wrongly around the node (e.g. 90° instead of 450° at a
+  //! valence-5 node, with every face positive), so arcs cannot leave it in their sectors.
+  //! Listed in `problems` when the extraction is not equivalent.
+  int bad_cones = 0;
 };
 
 struct TraceOptions {

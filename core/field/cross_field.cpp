@@ -76,7 +76,7 @@ CrossFieldSolver::CrossFieldSolver(const TriMesh& mesh, const GeometryCache& g,
   const double lambda = options.constraint_weight;
   for (int k = 0; k < nc; ++k)
     triplets.emplace_back(field_.constraints.face[k], field_.constraints.face[k], lambda);
-  if (nc == 0) {
+  if (!layout.arcs.empty()) {
     // Gauge: pin a face next to the middle of the longest arc, along that arc (away from nodes).
     int best_arc = 0;
     for (size_t a = 0; a < layout.arcs.size(); ++a)
@@ -87,10 +87,15 @@ CrossFieldSolver::CrossFieldSolver(const TriMesh& mesh, const GeometryCache& g,
     const auto h = mesh.find_halfedge(mesh.vertex_handle(path[m]), mesh.vertex_handle(path[m + 1]));
     const auto fh = mesh.is_boundary(h) ? mesh.face_handle(mesh.opposite_halfedge_handle(h))
                                         : mesh.face_handle(h);
-    field_.gauge_face = fh.idx();
-    triplets.emplace_back(field_.gauge_face, field_.gauge_face, lambda);
-    gauge_angle_ = g.angle_in_face(field_.gauge_face, mesh.point(mesh.vertex_handle(path[m + 1])) -
-                                                          mesh.point(mesh.vertex_handle(path[m])));
+    arc_gauge_face_ = fh.idx();
+    arc_gauge_angle_ =
+        g.angle_in_face(arc_gauge_face_, mesh.point(mesh.vertex_handle(path[m + 1])) -
+                                             mesh.point(mesh.vertex_handle(path[m])));
+    if (nc == 0) {
+      field_.gauge_face = arc_gauge_face_;
+      gauge_angle_ = arc_gauge_angle_;
+      triplets.emplace_back(field_.gauge_face, field_.gauge_face, lambda);
+    }
   }
   matrix_.resize(nf, nf);
   matrix_.setFromTriplets(triplets.begin(), triplets.end());
@@ -183,10 +188,39 @@ void CrossFieldSolver::warm_start(const GeometryCache& g, bool allow_factorizati
       others.push_back(cl);
     }
   // The relaxed system needs one dense right-hand side per relaxed cluster (#F doubles each):
-  // bounded by the cluster count and by 8M entries (64 MB).
-  const bool relaxed = options_.warm_start == ClusterWarmStart::Relaxed &&
-                       static_cast<int>(others.size()) <= options_.max_relaxed_clusters &&
-                       static_cast<double>(others.size()) * g.n_faces <= 8e6;
+  // bounded by the cluster count and by 8M entries (64 MB). Beyond that, Relaxed falls back to
+  // LayoutField (the largest cluster's field twisted a bunny cage layout's field by quarter
+  // turns against the arcs: 40% fold-overs, arcs running backwards).
+  const bool relaxed_fits = static_cast<int>(others.size()) <= options_.max_relaxed_clusters &&
+                            static_cast<double>(others.size()) * g.n_faces <= 8e6;
+  ClusterWarmStart mode = options_.warm_start;
+  if (mode == ClusterWarmStart::Relaxed && !relaxed_fits) mode = ClusterWarmStart::LayoutField;
+  if (mode == ClusterWarmStart::LayoutField && arc_gauge_face_ < 0)
+    mode = ClusterWarmStart::LargestCluster;  // no arc to pin the reference field along
+  if (mode == ClusterWarmStart::LayoutField) {
+    if (!allow_factorization) return;  // keep the offsets (update_layout)
+    Eigen::SparseMatrix<double> L0 = matrix_;
+    Eigen::VectorXd b = Eigen::VectorXd::Zero(g.n_faces);
+    for (int e = 0; e < g.n_edges; ++e) {
+      if (g.edge_face_i[e] < 0 || g.edge_face_j[e] < 0) continue;
+      const double k = g.kappa[e] + kQuarter * field_.period_jump[e];
+      b(g.edge_face_i[e]) -= k;
+      b(g.edge_face_j[e]) += k;
+    }
+    for (int k = 0; k < nc; ++k)
+      if (active(k)) L0.coeffRef(field_.constraints.face[k], field_.constraints.face[k]) -= lambda;
+    if (field_.gauge_face >= 0) L0.coeffRef(field_.gauge_face, field_.gauge_face) -= lambda;
+    L0.coeffRef(arc_gauge_face_, arc_gauge_face_) += lambda;
+    b(arc_gauge_face_) += lambda * arc_gauge_angle_;
+    factorize(spare_, L0);
+    ++field_.timings.solves;
+    std::fill(cluster_offset_.begin(), cluster_offset_.end(), 0);
+    round_clusters(c, spare_.solve(b));
+    field_.timings.warm_start_s +=
+        seconds_since(t0) - (field_.timings.factorize_s - factorize_before);
+    return;
+  }
+  const bool relaxed = mode == ClusterWarmStart::Relaxed;
   if (!relaxed && !allow_factorization) return;
   std::fill(cluster_offset_.begin(), cluster_offset_.end(), 0);
   if (others.empty()) return;

@@ -20,8 +20,14 @@ enum class ClusterWarmStart {
   //! then round each (MIQ-style relax-and-round).
   Relaxed,
   //! The smoothest field held only by the largest cluster (one extra factorization), every
-  //! other cluster rounded against it. Used when there are more than `max_relaxed_clusters`.
+  //! other cluster rounded against it.
   LargestCluster,
+  //! Every cluster rounded against the smoothest field without direction constraints, pinned
+  //! along the layout's longest arc: the field stays as close as possible to the layout's own
+  //! directions, so no cluster twists it by quarter turns against the arcs (cage layouts that
+  //! ignore curvature: issue #4 bunny). One extra factorization. Relaxed falls back to it
+  //! above `max_relaxed_clusters` clusters.
+  LayoutField,
 };
 
 //! What is released when the field contradicts the layout near an edge (see CrossFieldOptions).
@@ -36,7 +42,7 @@ struct CrossFieldOptions {
   int max_rounding_passes = 5;  //!< re-rounding of cluster rotations after each solve
   ClusterWarmStart warm_start = ClusterWarmStart::Relaxed;
   //! Above this many clusters (or 8M right-hand-side entries, #F per cluster) the relaxed warm
-  //! start (one solve per cluster) falls back to LargestCluster.
+  //! start (one solve per cluster) falls back to LayoutField.
   int max_relaxed_clusters = 64;
   //! Constraint clusters that contradict the layout's topology (the solved field then jumps by
   //! more than 45° across some edge, i.e. its principal matching differs from the prescribed
@@ -135,6 +141,8 @@ class CrossFieldSolver {
   bool active(int k) const { return cluster_active_[cluster_of_[k]] && constraint_active_[k]; }
   std::vector<Vec3> constraint_dir_;  //!< original 3D directions
   double gauge_angle_ = 0;
+  int arc_gauge_face_ = -1;     //!< face along the middle of the longest arc
+  double arc_gauge_angle_ = 0;  //!< that arc edge's angle in the face
   Eigen::SparseMatrix<double> matrix_;
   SpdSolver solver_{"cross field"};
   //! Second factorization of the same pattern (trial drops, largest-cluster warm start), so a

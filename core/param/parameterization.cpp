@@ -235,8 +235,14 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
                               " is not a finite number");
     prescribed_length[l.arc_id] = l.length;
   }
+  // Do the halfedges x→y and y→z lie in one face (a path turning inside a triangle)?
+  auto same_face = [&](int x, int y, int z) {
+    const auto h0 = mesh.find_halfedge(mesh.vertex_handle(x), mesh.vertex_handle(y));
+    const auto h1 = mesh.find_halfedge(mesh.vertex_handle(y), mesh.vertex_handle(z));
+    return !mesh.is_boundary(h0) && mesh.face_handle(h0) == mesh.face_handle(h1);
+  };
   // Arcs: node connection (3); along boundary and pinned arcs every path vertex is on the
-  // iso-line.
+  // iso-line (except the apex of an "ear", below).
   for (int a = 0; a < topo.num_arcs; ++a) {
     const LayoutArc& arc = layout.arcs[a];
     const ArcStrip& s = labeling_.strips[a];
@@ -274,6 +280,13 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
       }
       const bool last = k == K;
       if (!iso_all && !last) continue;
+      // An "ear": the path turns at w_k inside one triangle (both path edges belong to the same
+      // face, e.g. a boundary triangle with two boundary edges). Putting w_k on the iso-line too
+      // would map that triangle to a segment (inspired_mesh: parametric area 0, E_confor 1e28),
+      // so w_k stays free and the iso-line cuts across the triangle.
+      if (!last && (same_face(s.walk[k - 1], s.walk[k], s.walk[k + 1]) ||
+                    same_face(s.walk[k + 1], s.walk[k], s.walk[k - 1])))
+        continue;
       if (last && arc.dangling()) break;
       const int face = mesh.face_handle(mesh.find_halfedge(mesh.vertex_handle(s.walk[k - 1]),
                                                            mesh.vertex_handle(s.walk[k])))
