@@ -210,9 +210,11 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     report["metrics"] = {{"E_confor", m.E_confor},
                          {"E_planar", m.E_planar},
                          {"E_angle_deg", m.E_angle_deg},
-                         {"foldovers", m.foldovers}};
+                         {"foldovers", m.foldovers},
+                         {"degenerate_faces", m.degenerate}};
     report["structurally_equivalent"] = ex.structurally_equivalent;
     report["extraction_problems"] = ex.problems;
+    report["bad_cones"] = ex.bad_cones;
     report["parameterization"] = {{"wedges", param.wedges},
                                   {"cut_edges", param.cut_edges},
                                   {"constraint_rows", param.constraint_rows},
