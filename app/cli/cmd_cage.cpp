@@ -35,10 +35,7 @@ void write_cage_obj(const PolyMesh& cage, const std::string& path) {
 
 int run_cage_layout(const CageLayoutOptions& o, const CommonOptions& common) {
   const auto t0 = std::chrono::steady_clock::now();
-  MeshReport mesh_report;
-  const TriMesh mesh = load_mesh(o.mesh, &mesh_report);
-  for (const auto& w : mesh_report.warnings)
-    std::cerr << "warning: " << o.mesh << ": " << w << "\n";
+  const TriMesh mesh = load_mesh_printing_warnings(o.mesh);
   CageOptions options;
   options.resolution = o.resolution;
   options.attempts = o.attempts;

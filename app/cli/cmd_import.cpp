@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/cli/commands.h"
+#include "app/cli/report.h"
 #include "core/base/atomic_file.h"
 #include "core/base/errors.h"
 #include "core/layout/layout_io.h"
@@ -17,10 +18,6 @@
 namespace qs::cli {
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 nlohmann::json layout_counts(const TriMesh& mesh, const Layout& layout) {
   const LayoutTopology topo = build_topology(mesh, layout);
@@ -132,10 +129,7 @@ int run_import_quads(const ImportQuadsOptions& o, const CommonOptions& common) {
 
 int run_perturb(const PerturbOptions& o, const CommonOptions& common) {
   const auto t0 = std::chrono::steady_clock::now();
-  MeshReport mesh_report;
-  const TriMesh mesh = load_mesh(o.mesh, &mesh_report);
-  for (const auto& w : mesh_report.warnings)
-    std::cerr << "warning: " << o.mesh << ": " << w << "\n";
+  const TriMesh mesh = load_mesh_printing_warnings(o.mesh);
   const Layout layout = load_layout(o.layout, mesh);
   PerturbLayoutOptions options;
   options.rings = o.rings;

@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -10,13 +11,19 @@
 #include "app/cli/signals.h"
 #include "core/base/atomic_file.h"
 #include "core/base/errors.h"
+#include "core/base/timing.h"
 #include "core/layout/layout.h"
 #include "core/mesh/mesh_io.h"
 
 namespace qs::cli {
 
-inline double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+//! Loads a mesh for a command that writes no report: its warnings go to stderr, prefixed by
+//! the file name. \throw InvalidInputError as load_mesh.
+inline TriMesh load_mesh_printing_warnings(const std::string& path) {
+  MeshReport report;
+  TriMesh mesh = load_mesh(path, &report);
+  for (const auto& w : report.warnings) std::cerr << "warning: " << path << ": " << w << "\n";
+  return mesh;
 }
 
 inline nlohmann::json mesh_json(const MeshReport& r) {

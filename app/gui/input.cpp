@@ -104,26 +104,16 @@ void App::update_hover(const glm::vec2& mouse) {
     ++interaction_version_;
   }
   hovered_vertex_ = vertex;
-  // Dangling tool: preview the route to the boundary vertex the click would end on.
-  if (tool_ == Tool::Dangling && arc_start_node_ >= 0) {
+  // Arc and dangling tools: preview the route to the node (or vertex) under the cursor, or to
+  // the boundary vertex the click would end on.
+  if ((tool_ == Tool::DrawArc || tool_ == Tool::Dangling) && arc_start_node_ >= 0) {
     const auto& layout = doc_.editor.layout();
     const int start = layout.node_index(arc_start_node_);
-    const int target = hit && start >= 0 && node != arc_start_node_ ? dangling_target(*hit) : -1;
-    if (start >= 0 && target != preview_target_vertex_) {
-      preview_target_vertex_ = target;
-      preview_path_.clear();
-      if (target >= 0) {
-        const RoutingObstacles obstacles = obstacles_of_layout(*doc_.mesh, layout);
-        preview_path_ = shortest_path(*doc_.mesh, layout.nodes[start].vertex, target, obstacles);
-      }
-      ++interaction_version_;
-    }
-  }
-  // Arc tool: preview the route to the node (or vertex) under the cursor.
-  if (tool_ == Tool::DrawArc && arc_start_node_ >= 0) {
-    const auto& layout = doc_.editor.layout();
-    const int start = layout.node_index(arc_start_node_);
-    int target = node >= 0 ? layout.nodes[layout.node_index(node)].vertex : vertex;
+    int target = -1;
+    if (tool_ == Tool::Dangling)
+      target = hit && start >= 0 && node != arc_start_node_ ? dangling_target(*hit) : -1;
+    else
+      target = node >= 0 ? layout.nodes[layout.node_index(node)].vertex : vertex;
     if (start >= 0 && target != preview_target_vertex_) {
       preview_target_vertex_ = target;
       preview_path_.clear();

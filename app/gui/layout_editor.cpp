@@ -38,6 +38,18 @@ double distance_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
   return (p - (a + t * ab)).norm();
 }
 
+// Appends an arc (next free id) and drops the now stale patches; returns the arc's id.
+int append_arc(Layout& layout, int from_id, int to_id, std::vector<int> path) {
+  LayoutArc arc;
+  arc.id = next_arc_id(layout);
+  arc.from = from_id;
+  arc.to = to_id;
+  arc.path = std::move(path);
+  layout.arcs.push_back(std::move(arc));
+  layout.patches.clear();
+  return layout.arcs.back().id;
+}
+
 }  // namespace
 
 Vec3 surface_position(const TriMesh& mesh, const SurfacePoint& p) {
@@ -279,14 +291,7 @@ EditResult LayoutEditor::add_arc(int from_id, int to_id) {
     return EditResult::fail("no free path from node " + std::to_string(from_id) + " to node " +
                             std::to_string(to_id) + " (other arcs are in the way)");
   Layout before = layout_;
-  LayoutArc arc;
-  arc.id = next_arc_id(layout_);
-  arc.from = from_id;
-  arc.to = to_id;
-  arc.path = std::move(path);
-  layout_.arcs.push_back(std::move(arc));
-  layout_.patches.clear();
-  const int id = layout_.arcs.back().id;
+  const int id = append_arc(layout_, from_id, to_id, std::move(path));
   commit("add arc " + std::to_string(id), std::move(before));
   return {true, {}, id, -1};
 }
@@ -324,15 +329,8 @@ EditResult LayoutEditor::add_stroke_arc(int from_id, int to_id,
       std::vector<int> path = route_stroke(*mesh_, layout_.nodes[from].vertex, end_vertex, stroke,
                                            obstacles, &error, options);
       if (path.empty()) return EditResult::fail(error);
-      LayoutArc arc;
-      arc.id = next_arc_id(edited);
-      arc.from = from_id;
-      arc.to = node.id;
-      arc.path = std::move(path);
-      edited.arcs.push_back(std::move(arc));
-      edited.patches.clear();
+      const int id = append_arc(edited, from_id, node.id, std::move(path));
       layout_ = std::move(edited);
-      const int id = layout_.arcs.back().id;
       commit("stroke arc " + std::to_string(id) + " to new node " + std::to_string(node.id),
              std::move(before));
       return {true, {}, id, node.id};
@@ -346,14 +344,7 @@ EditResult LayoutEditor::add_stroke_arc(int from_id, int to_id,
                                        stroke, obstacles, &error, options);
   if (path.empty()) return EditResult::fail(error);
   Layout before = layout_;
-  LayoutArc arc;
-  arc.id = next_arc_id(layout_);
-  arc.from = from_id;
-  arc.to = to_id;
-  arc.path = std::move(path);
-  layout_.arcs.push_back(std::move(arc));
-  layout_.patches.clear();
-  const int id = layout_.arcs.back().id;
+  const int id = append_arc(layout_, from_id, to_id, std::move(path));
   commit("stroke arc " + std::to_string(id), std::move(before));
   return {true, {}, id, -1};
 }
@@ -391,14 +382,7 @@ EditResult LayoutEditor::add_dangling_arc(int from_id, int boundary_vertex) {
                               " to boundary vertex " + std::to_string(boundary_vertex));
   }
   Layout before = layout_;
-  LayoutArc arc;
-  arc.id = next_arc_id(layout_);
-  arc.from = from_id;
-  arc.to = -1;
-  arc.path = std::move(path);
-  layout_.arcs.push_back(std::move(arc));
-  layout_.patches.clear();
-  const int id = layout_.arcs.back().id;
+  const int id = append_arc(layout_, from_id, -1, std::move(path));
   commit("dangling arc " + std::to_string(id), std::move(before));
   return {true, {}, id, -1};
 }

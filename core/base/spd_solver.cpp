@@ -6,14 +6,9 @@
 #include <vector>
 
 #include "core/base/errors.h"
+#include "core/base/timing.h"
 
 namespace qs {
-
-namespace {
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-}  // namespace
 
 struct SpdSolver::Impl {
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;

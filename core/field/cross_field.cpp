@@ -6,16 +6,13 @@
 #include <cmath>
 
 #include "core/base/errors.h"
+#include "core/base/timing.h"
 
 namespace qs {
 
 namespace {
 
 constexpr double kQuarter = M_PI / 2;
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 bool interior(const GeometryCache& g, int e) {
   return g.edge_face_i[e] >= 0 && g.edge_face_j[e] >= 0;

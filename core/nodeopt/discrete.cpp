@@ -3,15 +3,12 @@
 #include <algorithm>
 #include <chrono>
 
+#include "core/base/timing.h"
 #include "core/nodeopt/gradient.h"
 
 namespace qs {
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // Free neighbours of node n's vertex, in the order they are tried.
 std::vector<int> hop_candidates(const TriMesh& original, const Layout& layout, int n,

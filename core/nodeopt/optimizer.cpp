@@ -5,16 +5,13 @@
 #include <cmath>
 #include <memory>
 
+#include "core/base/timing.h"
 #include "core/nodeopt/discrete.h"
 #include "core/nodeopt/geodesic.h"
 
 namespace qs {
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // One solve of field + parameterization. The Pipeline is shared: a later trial without node
 // switches re-solves it in place (then it no longer holds this evaluation's solution).

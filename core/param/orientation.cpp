@@ -9,6 +9,7 @@
 
 #include "core/base/errors.h"
 #include "core/base/spd_solver.h"
+#include "core/base/timing.h"
 
 namespace qs {
 
@@ -403,7 +404,7 @@ Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& g,
          << " constrained faces (round " << round + 1 << ", primal residual " << ipm.primal_residual
          << ")";
       rep.message = ss.str();
-      rep.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      rep.time_s = seconds_since(t0);
       if (best_y.size() == 0) throw SolverError(rep.message);
       rep.message +=
           "; kept the best earlier round (" + std::to_string(best_folds) + " fold-overs)";
@@ -428,7 +429,7 @@ Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& g,
     ss << rep.foldovers_after << " fold-over(s) remain after " << rep.rounds << " round(s)";
     rep.message = ss.str();
   }
-  rep.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  rep.time_s = seconds_since(t0);
   return y;
 }
 

@@ -9,14 +9,11 @@
 #include <utility>
 
 #include "core/base/errors.h"
+#include "core/base/timing.h"
 
 namespace qs {
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 using Terms = std::vector<std::pair<int, double>>;
 
