@@ -10,8 +10,60 @@
 
 namespace qs {
 
+namespace {
+
+// Eigen's supernodal LLᵀ with one addition: taking over another instance's symbolic analysis
+// (ordering and supernodal structure) by copying its CHOLMOD factor, so a second solver for a
+// matrix of the same pattern skips the fill-reducing ordering.
+class SupernodalLlt
+    : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> {
+ public:
+  // Failures are reported as SolverError by SpdSolver; CHOLMOD's own console messages off.
+  SupernodalLlt() { cholmod().print = 0; }
+
+  //! \return false when \p from has no analysis or CHOLMOD could not copy it.
+  bool copy_analysis_from(SupernodalLlt& from) {
+    if (!from.m_analysisIsOk || from.m_cholmodFactor == nullptr) return false;
+    cholmod_factor* copy = cholmod_copy_factor(from.m_cholmodFactor, &cholmod());
+    if (copy == nullptr) return false;
+    if (m_cholmodFactor != nullptr) cholmod_free_factor(&m_cholmodFactor, &cholmod());
+    m_cholmodFactor = copy;
+    m_isInitialized = true;
+    m_info = Eigen::Success;
+    m_analysisIsOk = true;
+    m_factorizationIsOk = false;
+    return true;
+  }
+  //! Symbolic analysis with the fill-reducing ordering \p perm (size n, perm[k] = the column
+  //! eliminated k-th) instead of AMD/METIS; CHOLMOD still postorders its elimination tree.
+  void analyze_with_ordering(const Eigen::SparseMatrix<double>& A, std::vector<int>& perm) {
+    if (m_cholmodFactor != nullptr) cholmod_free_factor(&m_cholmodFactor, &cholmod());
+    cholmod_sparse a = Eigen::viewAsCholmod(A.selfadjointView<Eigen::Lower>());
+    cholmod_common& c = cholmod();
+    const int nmethods = c.nmethods, ordering = c.method[0].ordering;
+    c.nmethods = 1;
+    c.method[0].ordering = CHOLMOD_GIVEN;
+    m_cholmodFactor = cholmod_analyze_p(&a, perm.data(), nullptr, 0, &c);
+    c.nmethods = nmethods;
+    c.method[0].ordering = ordering;
+    m_isInitialized = true;
+    m_info = m_cholmodFactor != nullptr ? Eigen::Success : Eigen::NumericalIssue;
+    m_analysisIsOk = m_cholmodFactor != nullptr;
+    m_factorizationIsOk = false;
+  }
+  //! The ordering of the current analysis (empty without one).
+  std::vector<int> ordering() const {
+    if (!m_analysisIsOk || m_cholmodFactor == nullptr || m_cholmodFactor->Perm == nullptr)
+      return {};
+    const int* p = static_cast<const int*>(m_cholmodFactor->Perm);
+    return std::vector<int>(p, p + m_cholmodFactor->n);
+  }
+};
+
+}  // namespace
+
 struct SpdSolver::Impl {
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+  SupernodalLlt llt;
   Eigen::Index rows = -1;
   Eigen::Index nnz = -1;
   std::vector<int> outer, inner;  // pattern of the analyzed matrix (compressed)
@@ -20,15 +72,38 @@ struct SpdSolver::Impl {
 };
 
 SpdSolver::SpdSolver(std::string stage)
-    : impl_(std::make_unique<Impl>()), stage_(std::move(stage)) {}
+    : impl_(std::make_shared<Impl>()), stage_(std::move(stage)) {}
 SpdSolver::~SpdSolver() = default;
+SpdSolver::SpdSolver(const SpdSolver&) = default;
+SpdSolver& SpdSolver::operator=(const SpdSolver&) = default;
 SpdSolver::SpdSolver(SpdSolver&&) noexcept = default;
 SpdSolver& SpdSolver::operator=(SpdSolver&&) noexcept = default;
 
+void SpdSolver::detach(bool keep_analysis) {
+  if (impl_.use_count() <= 1) return;
+  auto own = std::make_shared<Impl>();
+  if (keep_analysis && impl_->analyzed && own->llt.copy_analysis_from(impl_->llt)) {
+    own->rows = impl_->rows;
+    own->nnz = impl_->nnz;
+    own->outer = impl_->outer;
+    own->inner = impl_->inner;
+    own->analyzed = true;
+  }
+  impl_ = std::move(own);
+}
+
 void SpdSolver::analyze(const Eigen::SparseMatrix<double>& A) {
   if (A.rows() != A.cols()) throw SolverError(stage_ + ": matrix is not square");
+  detach(false);
   const auto t0 = std::chrono::steady_clock::now();
-  impl_->llt.analyzePattern(A);
+  std::vector<int> hint = std::move(ordering_hint_);
+  ordering_hint_.clear();
+  if (static_cast<Eigen::Index>(hint.size()) == A.rows() && A.rows() > 0) {
+    impl_->llt.analyze_with_ordering(A, hint);
+    ++stats_.hinted_analyses;
+  } else {
+    impl_->llt.analyzePattern(A);
+  }
   if (impl_->llt.info() != Eigen::Success)
     throw SolverError(stage_ + ": symbolic analysis failed (" + std::to_string(A.rows()) +
                       " unknowns)");
@@ -48,7 +123,10 @@ void SpdSolver::analyze(const Eigen::SparseMatrix<double>& A) {
 }
 
 void SpdSolver::factorize(const Eigen::SparseMatrix<double>& A) {
-  if (!same_pattern(A)) analyze(A);
+  if (!same_pattern(A))
+    analyze(A);
+  else
+    detach(true);  // a copy keeps the shared factorization
   for (Eigen::Index k = 0; k < A.nonZeros(); ++k) {
     if (!std::isfinite(A.valuePtr()[k]))
       throw SolverError(stage_ + ": matrix has non-finite entries (" + std::to_string(A.rows()) +
@@ -89,6 +167,21 @@ Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& B) {
   return X;
 }
 
+bool SpdSolver::copy_analysis_from(const SpdSolver& other) {
+  if (this == &other || !other.impl_->analyzed || other.impl_->outer.empty()) return false;
+  const auto t0 = std::chrono::steady_clock::now();
+  detach(false);
+  if (!impl_->llt.copy_analysis_from(other.impl_->llt)) return false;
+  impl_->rows = other.impl_->rows;
+  impl_->nnz = other.impl_->nnz;
+  impl_->outer = other.impl_->outer;
+  impl_->inner = other.impl_->inner;
+  impl_->analyzed = true;
+  impl_->factorized = false;
+  stats_.analyze_s = seconds_since(t0);
+  return true;
+}
+
 bool SpdSolver::same_pattern(const Eigen::SparseMatrix<double>& A) const {
   if (!impl_->analyzed || A.rows() != impl_->rows || A.cols() != impl_->rows ||
       A.nonZeros() != impl_->nnz || !A.isCompressed() ||
@@ -100,6 +193,25 @@ bool SpdSolver::same_pattern(const Eigen::SparseMatrix<double>& A) const {
 
 bool SpdSolver::factorized() const {
   return impl_->factorized;
+}
+
+std::vector<int> SpdSolver::ordering() const {
+  return impl_->analyzed ? impl_->llt.ordering() : std::vector<int>{};
+}
+
+void SpdSolver::set_ordering_hint(std::vector<int> ordering) {
+  if (!ordering.empty()) {
+    // A permutation of 0..n-1, else CHOLMOD would reject it: cleared.
+    std::vector<char> seen(ordering.size(), 0);
+    for (int k : ordering) {
+      if (k < 0 || k >= static_cast<int>(ordering.size()) || seen[k]) {
+        ordering.clear();
+        break;
+      }
+      seen[k] = 1;
+    }
+  }
+  ordering_hint_ = std::move(ordering);
 }
 
 }  // namespace qs

@@ -5,6 +5,7 @@
 #include <Eigen/Sparse>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace qs {
 
@@ -12,6 +13,7 @@ namespace qs {
 struct SpdSolverStats {
   double analyze_s = 0, factorize_s = 0, solve_s = 0;
   int analyses = 0, factorizations = 0, solves = 0;
+  int hinted_analyses = 0;  //!< analyses that used a given ordering (set_ordering_hint)
 };
 
 class SpdSolver {
@@ -19,6 +21,13 @@ class SpdSolver {
   //! \p stage names the solve in error messages ("cross field", "parameterization", …).
   explicit SpdSolver(std::string stage = "linear solve");
   ~SpdSolver();
+  //! A copy shares the analysis and the factorization (no CHOLMOD work): it solves with the same
+  //! factor. The first analyze(), factorize() or copy_analysis_from() of either side gives that
+  //! side its own state first (copy-on-write; factorize() on an unchanged pattern copies the
+  //! symbolic analysis), so the other keeps its factorization. Copies share CHOLMOD's workspace:
+  //! do not use them from different threads at the same time.
+  SpdSolver(const SpdSolver&);
+  SpdSolver& operator=(const SpdSolver&);
   SpdSolver(SpdSolver&&) noexcept;
   SpdSolver& operator=(SpdSolver&&) noexcept;
 
@@ -29,6 +38,11 @@ class SpdSolver {
   //! solver handed on to a new system with an identical pattern keeps its analysis.
   //! \throw SolverError when A is not positive definite or not finite.
   void factorize(const Eigen::SparseMatrix<double>& A);
+  //! Takes over \p other's symbolic analysis (CHOLMOD factor copied; its numeric values are
+  //! overwritten by the next factorize()), so a second solver for a matrix with the same
+  //! pattern needs no analysis of its own. Any factorization of this solver is dropped.
+  //! \return false (and nothing changed) when \p other has no analysis of a compressed matrix.
+  bool copy_analysis_from(const SpdSolver& other);
   //! True when the last analysis was of exactly the pattern of \p A (compressed storage).
   bool same_pattern(const Eigen::SparseMatrix<double>& A) const;
   //! Solves A x = b with the last factorization. \throw SolverError on non-finite results.
@@ -38,11 +52,25 @@ class SpdSolver {
   bool factorized() const;
   const SpdSolverStats& stats() const { return stats_; }
 
+  //! The fill-reducing ordering of the last analysis: entry k is the column eliminated k-th
+  //! (CHOLMOD's permutation, size n). Empty before the first analysis.
+  std::vector<int> ordering() const;
+  //! The next analysis (of a pattern other than the analyzed one) uses \p ordering (a
+  //! permutation of 0..n-1, as ordering() returns) instead of computing one with AMD/METIS,
+  //! when its size matches the matrix; a good ordering of a similar pattern (e.g. mapped from
+  //! the previous step's system) gives nearly the same fill at a fraction of the analysis cost.
+  //! Used once; an empty vector or one that is not a permutation clears the hint.
+  void set_ordering_hint(std::vector<int> ordering);
+
  private:
+  //! Gives this solver its own state if a copy shares it (\p keep_analysis: copy the analysis).
+  void detach(bool keep_analysis);
+
   struct Impl;
-  std::unique_ptr<Impl> impl_;
+  std::shared_ptr<Impl> impl_;
   std::string stage_;
   SpdSolverStats stats_;
+  std::vector<int> ordering_hint_;  //!< for the next analysis (set_ordering_hint)
 };
 
 }  // namespace qs

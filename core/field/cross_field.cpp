@@ -111,6 +111,12 @@ CrossFieldSolver::~CrossFieldSolver() = default;
 
 void CrossFieldSolver::factorize(SpdSolver& solver, const Eigen::SparseMatrix<double>& A) {
   const auto t0 = std::chrono::steady_clock::now();
+  if (!solver.same_pattern(A)) {
+    // Every matrix of this stage has the pattern of the dual graph (constraints only change
+    // the diagonal): the other solver's analysis is reused instead of ordering again.
+    SpdSolver& other = &solver == &solver_ ? spare_ : solver_;
+    if (other.same_pattern(A)) solver.copy_analysis_from(other);
+  }
   solver.factorize(A);
   field_.timings.factorize_s += seconds_since(t0);
   ++field_.timings.factorizations;

@@ -1,0 +1,119 @@
+// SpdSolver: CHOLMOD wrapper with reused symbolic analysis (issue #3 item 5).
+#include "core/base/spd_solver.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "core/base/errors.h"
+
+namespace qs {
+namespace {
+
+// Graph Laplacian of an n×n grid plus `shift` on the diagonal (SPD for shift > 0). `bump`
+// adds extra weight to every third diagonal entry, so two matrices share the pattern but not
+// the values.
+Eigen::SparseMatrix<double> grid_matrix(int n, double shift, double bump = 0) {
+  std::vector<Eigen::Triplet<double>> t;
+  auto id = [n](int i, int j) { return i * n + j; };
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const int a = id(i, j);
+      double diag = shift + (a % 3 == 0 ? bump : 0.0);
+      for (const auto [di, dj] : {std::pair{1, 0}, std::pair{0, 1}}) {
+        if (i + di >= n || j + dj >= n) continue;
+        const int b = id(i + di, j + dj);
+        t.emplace_back(a, b, -1.0);
+        t.emplace_back(b, a, -1.0);
+        t.emplace_back(b, b, 1.0);
+        diag += 1.0;
+      }
+      t.emplace_back(a, a, diag);
+    }
+  }
+  Eigen::SparseMatrix<double> A(n * n, n * n);
+  A.setFromTriplets(t.begin(), t.end());
+  A.makeCompressed();
+  return A;
+}
+
+Eigen::VectorXd random_vector(int size, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> dist(-1, 1);
+  Eigen::VectorXd b(size);
+  for (int k = 0; k < size; ++k) b[k] = dist(rng);
+  return b;
+}
+
+double relative_residual(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& x,
+                         const Eigen::VectorXd& b) {
+  return (A * x - b).norm() / b.norm();
+}
+
+TEST(SpdSolver, SolvesAndReusesTheAnalysisForTheSamePattern) {
+  const auto A = grid_matrix(20, 0.1);
+  const auto A2 = grid_matrix(20, 0.1, 5.0);  // same pattern, other values
+  const Eigen::VectorXd b = random_vector(static_cast<int>(A.rows()), 1);
+  SpdSolver solver("test");
+  solver.factorize(A);
+  EXPECT_LT(relative_residual(A, solver.solve(b), b), 1e-10);
+  solver.factorize(A2);
+  EXPECT_LT(relative_residual(A2, solver.solve(b), b), 1e-10);
+  EXPECT_EQ(solver.stats().analyses, 1);
+  EXPECT_EQ(solver.stats().factorizations, 2);
+  // A different pattern is analyzed again.
+  const auto B = grid_matrix(21, 0.1);
+  solver.factorize(B);
+  EXPECT_EQ(solver.stats().analyses, 2);
+  const Eigen::VectorXd c = random_vector(static_cast<int>(B.rows()), 2);
+  EXPECT_LT(relative_residual(B, solver.solve(c), c), 1e-10);
+}
+
+TEST(SpdSolver, CopiedAnalysisGivesTheSameSolutionWithoutAnAnalysis) {
+  const auto A = grid_matrix(25, 0.05);
+  const auto A2 = grid_matrix(25, 0.05, 3.0);
+  const Eigen::VectorXd b = random_vector(static_cast<int>(A.rows()), 3);
+  SpdSolver first("first"), second("second"), reference("reference");
+  first.factorize(A);
+  ASSERT_TRUE(second.copy_analysis_from(first));
+  EXPECT_TRUE(second.same_pattern(A2));
+  EXPECT_FALSE(second.factorized());  // only the analysis was taken over
+  second.factorize(A2);
+  EXPECT_EQ(second.stats().analyses, 0);
+  reference.factorize(A2);
+  const Eigen::VectorXd x = second.solve(b);
+  EXPECT_LT(relative_residual(A2, x, b), 1e-10);
+  EXPECT_LT((x - reference.solve(b)).norm(), 1e-10 * x.norm());
+  // The source keeps its own factorization of A.
+  EXPECT_LT(relative_residual(A, first.solve(b), b), 1e-10);
+}
+
+TEST(SpdSolver, CopyFromAnUnanalyzedSolverChangesNothing) {
+  SpdSolver empty("empty"), target("target");
+  EXPECT_FALSE(target.copy_analysis_from(empty));
+  EXPECT_FALSE(target.copy_analysis_from(target));
+  EXPECT_FALSE(target.factorized());
+  EXPECT_THROW(target.solve(Eigen::VectorXd(Eigen::VectorXd::Ones(3))), SolverError);
+}
+
+TEST(SpdSolver, RejectsIndefiniteAndNonFiniteInput) {
+  SpdSolver solver("test");
+  auto A = grid_matrix(6, -3.0);  // shifted below zero: indefinite
+  EXPECT_THROW(solver.factorize(A), SolverError);
+  auto B = grid_matrix(6, 0.1);
+  B.coeffRef(4, 4) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(solver.factorize(B), SolverError);
+  auto C = grid_matrix(6, 0.1);
+  solver.factorize(C);
+  Eigen::VectorXd b = Eigen::VectorXd::Ones(C.rows());
+  b[2] = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(solver.solve(b), SolverError);
+  Eigen::SparseMatrix<double> rect(3, 4);
+  EXPECT_THROW(solver.analyze(rect), SolverError);
+}
+
+}  // namespace
+}  // namespace qs
