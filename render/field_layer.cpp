@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "render/scene_cache.h"
+
 namespace qs::render {
 
 namespace {
@@ -205,6 +207,15 @@ void FieldLayer::draw(const FrameContext& frame) {
   glDrawArraysInstanced(GL_TRIANGLES, 0, 12, count);
   glDepthMask(GL_TRUE);
   glDisable(GL_BLEND);
+}
+
+std::uint64_t FieldLayer::settings_key() const {
+  FrameKey key;
+  for (bool b : {visible, show_cross, show_constraints}) key.add(b);
+  key.add(max_glyphs);
+  key.add(glyph_scale);
+  key.add(width);
+  return key.value();
 }
 
 void FieldLayer::ui() {

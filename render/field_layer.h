@@ -35,6 +35,7 @@ class FieldLayer : public Layer {
   void upload(const SceneData& data) override;
   void draw(const FrameContext& frame) override;
   void ui() override;
+  std::uint64_t settings_key() const override;
   bool reload(std::string* log);
 
   bool show_cross = true;

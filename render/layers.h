@@ -75,6 +75,11 @@ class Layer {
   virtual void draw(const FrameContext& frame) = 0;
   //! ImGui controls of the layer (inside an already open panel).
   virtual void ui() {}
+  //! Hash of every setting that changes what draw() shows (visibility, sizes, colours, modes),
+  //! so that a cached scene image is redrawn when one changes (render/scene_cache.h).
+  virtual std::uint64_t settings_key() const { return visible ? 1 : 0; }
+  //! True while draw() animates by itself (its image changes with FrameContext::time_s).
+  virtual bool animating() const { return false; }
   bool visible = true;
 };
 

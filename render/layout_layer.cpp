@@ -8,6 +8,8 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "render/scene_cache.h"
+
 namespace qs::render {
 
 glm::vec3 LayoutColors::valence(int valence) {
@@ -322,6 +324,15 @@ void LayoutLayer::draw(const FrameContext& frame) {
     draw_points(frame, issue_vao_, issue_points_, pulse, 2.5f * pull);
   }
   glDisable(GL_BLEND);
+}
+
+std::uint64_t LayoutLayer::settings_key() const {
+  FrameKey key;
+  for (bool b : {visible, show_nodes, show_arcs, show_issues, show_trajectories, show_quads})
+    key.add(b);
+  key.add(node_size);
+  key.add(arc_width);
+  return key.value();
 }
 
 void LayoutLayer::ui() {

@@ -32,6 +32,9 @@ class LayoutLayer : public Layer {
   void upload(const SceneData& data) override;
   void draw(const FrameContext& frame) override;
   void ui() override;
+  std::uint64_t settings_key() const override;
+  //! Validation problems pulse while they are shown.
+  bool animating() const override { return visible && show_issues && issue_points_ > 0; }
   bool reload(std::string* log);
 
   bool show_nodes = true;

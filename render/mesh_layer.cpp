@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "render/scene_cache.h"
+
 namespace qs::render {
 
 MeshLayer::MeshLayer() {
@@ -50,6 +52,21 @@ void MeshLayer::upload(const SceneData& data) {
         }
       }
       corners_ = static_cast<int>(buffer.size() / 6);
+      // Closed and consistently oriented (the loader checks orientation): the sign of the
+      // enclosed volume tells whether faces wind counter-clockwise seen from outside.
+      closed_ = true;
+      for (auto heh : mesh.halfedges())
+        if (mesh.is_boundary(heh)) {
+          closed_ = false;
+          break;
+        }
+      double volume6 = 0.0;
+      for (auto fh : mesh.faces()) {
+        auto it = mesh.cfv_begin(fh);
+        const Vec3 a = mesh.point(*it++), b = mesh.point(*it++), c = mesh.point(*it);
+        volume6 += OpenMesh::dot(a, OpenMesh::cross(b, c));
+      }
+      outward_ = volume6 >= 0.0;
       // Parameter units are world units: about 3 mesh edges per checker cell makes the
       // iso-lines readable at any model scale.
       double edge_sum = 0;
@@ -98,9 +115,27 @@ void MeshLayer::draw(const FrameContext& frame) {
   // Push the surface back a little so that arcs and nodes drawn on it win the depth test.
   glEnable(GL_POLYGON_OFFSET_FILL);
   glPolygonOffset(1.0f, 1.0f);
+  const bool cull = cull_hidden_faces && closed_;
+  if (cull) {
+    glEnable(GL_CULL_FACE);
+    glFrontFace(GL_CCW);
+    glCullFace(outward_ ? GL_BACK : GL_FRONT);
+  }
   vao_.bind();
   glDrawArrays(GL_TRIANGLES, 0, corners_);
   glDisable(GL_POLYGON_OFFSET_FILL);
+  if (cull) glDisable(GL_CULL_FACE);
+}
+
+std::uint64_t MeshLayer::settings_key() const {
+  FrameKey key;
+  for (bool b : {visible, flat_shading, wireframe, checker, show_foldovers, cull_hidden_faces})
+    key.add(b);
+  key.add(checker_scale);
+  key.add(wire_width);
+  key.add(front_color);
+  key.add(back_color);
+  return key.value();
 }
 
 void MeshLayer::ui() {
@@ -118,6 +153,14 @@ void MeshLayer::ui() {
   if (!has_uv_) {
     ImGui::EndDisabled();
     ImGui::TextDisabled("No parameterization yet (the pipeline provides it).");
+  }
+  if (closed_) {
+    ImGui::Checkbox("Cull hidden faces", &cull_hidden_faces);
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip(
+          "The mesh is closed: faces turned away from the camera are always "
+          "hidden, skipping them makes every frame cheaper. Turn off to see the "
+          "inside when the view cuts into the surface.");
   }
   ImGui::SliderFloat("Wire width", &wire_width, 0.5f, 3.0f, "%.1f px");
   ImGui::ColorEdit3("Front", &front_color.x, ImGuiColorEditFlags_NoInputs);

@@ -17,6 +17,7 @@ class MeshLayer : public Layer {
   void upload(const SceneData& data) override;
   void draw(const FrameContext& frame) override;
   void ui() override;
+  std::uint64_t settings_key() const override;
   //! Recompiles the shaders (Debug: from disk). Returns false and keeps the old ones on error.
   bool reload(std::string* log);
 
@@ -26,10 +27,16 @@ class MeshLayer : public Layer {
   bool show_foldovers = true;
   float checker_scale = 1.0f;
   float wire_width = 1.0f;
+  //! Closed meshes: skip the faces that turn away from the camera (they are always hidden
+  //! behind the rest of the surface), which halves the rasterizer's work. Open meshes show
+  //! both sides regardless.
+  bool cull_hidden_faces = true;
   glm::vec3 front_color{0.78f, 0.76f, 0.72f};
   glm::vec3 back_color{0.55f, 0.60f, 0.72f};
 
   bool has_parameterization() const { return has_uv_; }
+  //! True when the uploaded mesh is closed (no boundary), so hidden faces can be culled.
+  bool mesh_closed() const { return closed_; }
 
  private:
   GlProgram program_;
@@ -38,6 +45,8 @@ class MeshLayer : public Layer {
   GlBuffer param_;     // per corner: uv, fold-over flag
   int corners_ = 0;
   bool has_uv_ = false;
+  bool closed_ = false;
+  bool outward_ = true;  // counter-clockwise faces seen from outside (positive volume)
   std::uint64_t mesh_version_ = ~0ull;
   std::uint64_t param_version_ = ~0ull;
   const void* mesh_ptr_ = nullptr;

@@ -20,6 +20,7 @@
 #include "app/gui/history.h"
 #include "app/gui/pipeline_job.h"
 #include "app/gui/screenshot.h"
+#include "app/gui/thread_priority.h"
 
 #ifndef QS_ASSETS_DIR
 #define QS_ASSETS_DIR "assets"
@@ -83,7 +84,13 @@ void apply_style(float scale) {
 }  // namespace
 
 App::App(AppOptions options) : options_(std::move(options)) {
-  worker_ = std::make_unique<Worker>(pipeline_step);
+  // The solver threads run below the UI's priority (lowered at the first step of every job, so
+  // that the math libraries' thread pools, created on first use, are caught too).
+  worker_ = std::make_unique<Worker>(
+      [nice = options_.worker_nice](WorkerState& state, const WorkerObserver& observer) {
+        if (state.iteration == 0) lower_solver_thread_priority(nice);
+        return pipeline_step(state, observer);
+      });
   doc_.editor.on_change = [this](const Layout& layout) { on_layout_edited(layout); };
   recent_.load();
 }
@@ -277,6 +284,7 @@ void App::shutdown() {
     layout_layer_.reset();
     field_layer_.reset();
     background_.reset();
+    scene_cache_.release();
     ImGui_ImplOpenGL3_Shutdown();
     ImGui_ImplGlfw_Shutdown();
     ImGui::DestroyContext();
@@ -348,14 +356,16 @@ int App::run() {
     worker_->send(cmd::Run{});
     run_requested_ = true;
   }
+  scene_cache_.set_enabled(options_.scene_cache);
   // Benchmark: a few warm-up frames (shader compilation, first uploads), then N timed frames.
   constexpr int kBenchWarmup = 10;
   const int bench_total = options_.bench_frames > 0 ? kBenchWarmup + options_.bench_frames : 0;
-  std::vector<double> bench_ms;
-  bench_ms.reserve(std::size_t(std::max(0, options_.bench_frames)));
-  std::uint64_t bench_uploads = 0;
+  // Automation measures whole frames: wait for the GPU (llvmpipe renders on the CPU).
+  const bool timed = bench_total > 0 || options_.frames > 0;
+  std::uint64_t bench_start_version = 0;
+  int bench_start_iteration = 0;
+  auto bench_start_time = std::chrono::steady_clock::now();
 
-  double frame_seconds = 0.0;
   auto last = std::chrono::steady_clock::now();
   while (!glfwWindowShouldClose(window_) && !quit_now_) {
     glfwPollEvents();
@@ -368,11 +378,19 @@ int App::run() {
     const float dt = std::chrono::duration<float>(frame_start - last).count();
     last = frame_start;
     camera_.update(std::min(dt, 0.1f));
+    if (options_.bench_orbit) {
+      // A small trackball drag every frame: the worst case, the scene re-renders each frame.
+      const glm::vec2 centre = 0.5f * camera_.viewport();
+      camera_.begin_orbit(centre);
+      camera_.orbit_to(centre + glm::vec2(3.0f, 1.0f));
+    }
 
-    const std::uint64_t version_before = snapshot_version_;
+    profile_last_ = frame_start;
     frame();
-    render_scene(fb_w, fb_h);
+    profile_mark(0);
+    const bool scene_rendered = render_scene(fb_w, fb_h);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    profile_mark(7);
     ++frame_count_;
     if (scripted_stroke && frame_count_ == 2) {
       apply_scripted_stroke();
@@ -411,44 +429,70 @@ int App::run() {
       options_.screenshot_path.clear();  // once
     }
     glfwSwapBuffers(window_);
-    if (bench_total > 0) {
-      glFinish();  // count the frame's GPU work too (llvmpipe renders on the CPU)
-      if (frame_count_ > kBenchWarmup) {
-        bench_ms.push_back(std::chrono::duration<double, std::milli>(
-                               std::chrono::steady_clock::now() - frame_start)
-                               .count());
-        if (snapshot_version_ != version_before) ++bench_uploads;
+    if (timed) glFinish();  // count the frame's GPU work too (llvmpipe renders on the CPU)
+    profile_mark(8);
+    if (options_.frame_profile) ++profile_frames_;
+    frame_stats_.add_frame(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - frame_start)
+            .count(),
+        scene_rendered, snapshot_version_, worker_->version());
+    if (bench_total > 0 && frame_count_ == kBenchWarmup) {
+      frame_stats_.clear_times();  // the timed frames start now
+      bench_start_version = worker_->version();
+      bench_start_time = std::chrono::steady_clock::now();
+      bench_start_iteration = snapshot_ ? snapshot_->iteration : 0;
+      if (options_.frame_profile) {
+        std::fill(std::begin(profile_ms_), std::end(profile_ms_), 0.0);
+        profile_frames_ = 0;
       }
     }
-    frame_seconds +=
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - frame_start).count();
     if (due && (options_.quit || bench_total > 0)) break;
+    {
+      // At most ~60 frames/s, also when vertical sync does not throttle (software GL, no
+      // vblank) and in benchmarks (the frame time above is the work of one frame): wait for
+      // input for the rest of the frame budget, leaving the CPU to the solver.
+      constexpr double kFrameBudget = 1.0 / 60.0;
+      const double spent =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - frame_start).count();
+      if (spent < kFrameBudget) glfwWaitEventsTimeout(kFrameBudget - spent);
+    }
   }
-  if (!bench_ms.empty()) {
-    std::vector<double> sorted = bench_ms;
-    std::sort(sorted.begin(), sorted.end());
-    double sum = 0.0;
-    for (double t : sorted) sum += t;
-    const double mean = sum / double(sorted.size());
-    const std::size_t k95 =
-        std::min(sorted.size() - 1, std::size_t(std::ceil(0.95 * double(sorted.size()))) - 1);
+  const FrameSummary stats = frame_stats_.summary();
+  if (bench_total > 0 && stats.frames > 0) {
+    const double bench_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - bench_start_time).count();
     const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    GLint samples = 0;
-    glGetIntegerv(GL_SAMPLES, &samples);
     std::printf(
-        "bench: %zu frames at %dx%d, mesh %zu faces, %zu nodes, %zu arcs; frame time mean %.2f "
-        "ms, p95 %.2f ms, max %.2f ms; %.1f fps (mean); %llu new snapshots shown; field "
-        "glyphs %s; %d MSAA samples; renderer: %s\n",
-        sorted.size(), fb_w, fb_h, doc_.mesh ? std::size_t(doc_.mesh->n_faces()) : std::size_t(0),
-        doc_.editor.layout().nodes.size(), doc_.editor.layout().arcs.size(), mean, sorted[k95],
-        sorted.back(), mean > 0.0 ? 1000.0 / mean : 0.0,
-        static_cast<unsigned long long>(bench_uploads),
-        field_layer_ && field_layer_->visible ? "on" : "off", samples, renderer ? renderer : "?");
+        "bench: %d frames at %dx%d, mesh %zu faces, %zu nodes, %zu arcs; frame time mean %.2f "
+        "ms, p95 %.2f ms, max %.2f ms; %.1f fps (mean); %.1f frames/s presented (paced at "
+        "60); scene rendered in %d frames; %llu new "
+        "snapshots published, %d drawn, max lag %d frame(s); job: %s, steps %d -> %d; camera "
+        "%s; field glyphs %s; %d MSAA samples; scene cache %s; motion resolution %.2f; worker nice "
+        "%d; renderer: "
+        "%s\n",
+        stats.frames, fb_w, fb_h, doc_.mesh ? std::size_t(doc_.mesh->n_faces()) : std::size_t(0),
+        doc_.editor.layout().nodes.size(), doc_.editor.layout().arcs.size(), stats.mean_ms,
+        stats.p95_ms, stats.max_ms, stats.fps,
+        bench_seconds > 0.0 ? double(stats.frames) / bench_seconds : 0.0, stats.scene_renders,
+        static_cast<unsigned long long>(worker_->version() - bench_start_version),
+        stats.snapshots_drawn, stats.max_snapshot_lag,
+        snapshot_ ? to_string(snapshot_->status) : "none", bench_start_iteration,
+        snapshot_ ? snapshot_->iteration : 0, options_.bench_orbit ? "orbiting" : "still",
+        field_layer_ && field_layer_->visible ? "on" : "off", scene_cache_.samples(),
+        scene_cache_.enabled() ? "on" : "off", options_.motion_resolution, options_.worker_nice,
+        renderer ? renderer : "?");
   }
-  if (options_.frames > 0 && frame_count_ > 0) {
-    const double mean_ms = 1000.0 * frame_seconds / frame_count_;
-    std::printf("frames: %d, mean frame time %.1f ms (%.0f fps)\n", frame_count_, mean_ms,
-                mean_ms > 0.0 ? 1000.0 / mean_ms : 0.0);
+  if (options_.frames > 0 && stats.frames > 0)
+    std::printf("%s\n", format_frame_summary(stats).c_str());
+  if (options_.frame_profile && profile_frames_ > 0) {
+    static const char* kStageNames[kProfileStages] = {"events+ui", "upload", "clear+background",
+                                                      "surface",   "field",  "layout",
+                                                      "blit",      "imgui",  "swap"};
+    std::printf("frame profile (ms per frame, glFinish between stages, %d frames):",
+                profile_frames_);
+    for (int i = 0; i < kProfileStages; ++i)
+      std::printf(" %s %.2f%s", kStageNames[i], profile_ms_[i] / profile_frames_,
+                  i + 1 < kProfileStages ? ";" : "\n");
   }
   if (doc_.dirty && !automation())
     std::fprintf(stderr, "quadsketch: unsaved edits are in %s\n", autosave_path().c_str());
@@ -494,15 +538,15 @@ void App::frame() {
   ImGui::Render();
 }
 
-void App::render_scene(int fb_width, int fb_height) {
-  glViewport(0, 0, fb_width, fb_height);
-  glClearColor(0.3f, 0.31f, 0.33f, 1.0f);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LEQUAL);
-  glEnable(GL_MULTISAMPLE);
-  background_->draw();
+void App::profile_mark(int stage) {
+  if (!options_.frame_profile) return;
+  glFinish();
+  const auto now = std::chrono::steady_clock::now();
+  profile_ms_[stage] += std::chrono::duration<double, std::milli>(now - profile_last_).count();
+  profile_last_ = now;
+}
 
+bool App::render_scene(int fb_width, int fb_height) {
   render::SceneData scene;
   scene.mesh = doc_.mesh.get();
   scene.mesh_version = doc_.mesh_version;
@@ -553,12 +597,68 @@ void App::render_scene(int fb_width, int fb_height) {
     scene.field = snapshot_->field.get();
     scene.field_version = snapshot_->version;
   }
-  for (render::Layer* layer : {static_cast<render::Layer*>(mesh_layer_.get()),
-                               static_cast<render::Layer*>(field_layer_.get()),
-                               static_cast<render::Layer*>(layout_layer_.get())}) {
-    layer->upload(scene);
-    layer->draw(frame);
+  render::Layer* const layers[] = {mesh_layer_.get(), field_layer_.get(), layout_layer_.get()};
+  // Uploads happen only when a version changed (a new snapshot, an edit).
+  for (render::Layer* layer : layers) layer->upload(scene);
+  profile_mark(1);
+
+  // Everything the scene image depends on; an unchanged key reuses the cached image.
+  render::FrameKey key;
+  key.add(camera_.view());
+  key.add(camera_.projection());
+  key.add(frame.framebuffer);
+  key.add(frame.pixel_ratio);
+  key.add(background_->top);
+  key.add(background_->bottom);
+  render::add_scene(key, scene);
+  for (render::Layer* layer : layers) {
+    key.add(layer->settings_key());
+    if (layer->visible && layer->animating()) key.add(frame.time_s);
   }
+  // While the camera moves, a cheaper image at a fraction of the resolution; the first still
+  // frame renders at full resolution again.
+  render::FrameKey camera_key;
+  camera_key.add(camera_.view());
+  camera_key.add(camera_.projection());
+  camera_key.add(frame.framebuffer);
+  const bool moving = camera_key.value() != last_camera_key_;
+  last_camera_key_ = camera_key.value();
+  // A full-resolution moving frame is drawn straight into the window: the next frame needs a
+  // new image anyway, so caching it would only add a copy.
+  const bool direct = moving && options_.motion_resolution >= 1.0f;
+  bool draw_scene = true;
+  if (direct)
+    scene_cache_.invalidate();
+  else
+    draw_scene = scene_cache_.begin(fb_width, fb_height, key.value(),
+                                    moving ? options_.motion_resolution : 1.0f);
+  if (draw_scene) {
+    if (!direct) {
+      frame.framebuffer = {scene_cache_.render_width(), scene_cache_.render_height()};
+      frame.pixel_ratio *= float(frame.framebuffer.x) / float(std::max(1, fb_width));
+    }
+    glViewport(0, 0, frame.framebuffer.x, frame.framebuffer.y);
+    // Clear only the part drawn (a reduced-resolution image uses a corner of the buffer).
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(0, 0, frame.framebuffer.x, frame.framebuffer.y);
+    glClearColor(0.3f, 0.31f, 0.33f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glDisable(GL_SCISSOR_TEST);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LEQUAL);
+    glEnable(GL_MULTISAMPLE);
+    background_->draw();
+    profile_mark(2);
+    for (int i = 0; i < 3; ++i) {
+      layers[i]->draw(frame);
+      profile_mark(3 + i);
+    }
+    if (!direct) scene_cache_.end();
+  }
+  glViewport(0, 0, fb_width, fb_height);
+  if (!direct) scene_cache_.present();
+  profile_mark(6);
+  return draw_scene;
 }
 
 }  // namespace qs::app

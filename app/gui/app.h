@@ -10,6 +10,7 @@
 
 #include "app/gui/autosave.h"
 #include "app/gui/document.h"
+#include "app/gui/frame_stats.h"
 #include "app/gui/recent_files.h"
 #include "core/pipeline/worker.h"
 #include "render/background.h"
@@ -18,6 +19,7 @@
 #include "render/layout_layer.h"
 #include "render/mesh_layer.h"
 #include "render/picking.h"
+#include "render/scene_cache.h"
 
 struct GLFWwindow;
 
@@ -43,6 +45,18 @@ struct AppOptions {
   std::vector<int> stroke_vertices;
   int width = 1280;
   int height = 800;
+  //! Automation: orbit the camera a little every frame (the scene re-renders every frame, the
+  //! worst case for the frame rate).
+  bool bench_orbit = false;
+  //! Redraw on demand: reuse the last rendered scene image while nothing it shows changed.
+  bool scene_cache = true;
+  //! Resolution scale of the scene while the camera moves (software renderers without
+  //! multisampling only); 1: always full resolution.
+  float motion_resolution = 0.5f;
+  //! Nice value (0..19) of the solver threads; 0 leaves their priority alone.
+  int worker_nice = 10;
+  //! Per-stage frame timings (glFinish between stages), printed at exit.
+  bool frame_profile = false;
 };
 
 enum class Tool { Select, PlaceNode, DrawArc, Split, Delete, Pin, Stroke, Dangling };
@@ -65,7 +79,11 @@ class App {
   void shutdown();
   bool load_initial_files();
   void frame();
-  void render_scene(int fb_width, int fb_height);
+  //! Draws the scene (or the cached image of it) into the window framebuffer. Returns true
+  //! when the scene was rendered, false when the cached image was reused.
+  bool render_scene(int fb_width, int fb_height);
+  //! --frame-profile: waits for the GPU and adds the time since the previous mark to \p stage.
+  void profile_mark(int stage);
   void poll_worker();
   //! True when the latest job snapshot (not the editor's layout) should be drawn.
   bool job_layout_shown() const;
@@ -153,6 +171,8 @@ class App {
   std::unique_ptr<render::MeshLayer> mesh_layer_;
   std::unique_ptr<render::LayoutLayer> layout_layer_;
   std::unique_ptr<render::FieldLayer> field_layer_;
+  render::SceneCache scene_cache_;
+  std::uint64_t last_camera_key_ = 0;
   std::uint64_t picker_mesh_version_ = ~0ull;
 
   // Interaction state.
@@ -203,6 +223,9 @@ class App {
   std::string export_dir_;
   std::string export_message_;
   bool export_failed_ = false;
+  //! Bounding-box diagonal of the mesh (quad size slider range), cached per mesh version.
+  float mesh_diagonal_ = 1.0f;
+  std::uint64_t mesh_diagonal_version_ = ~0ull;
 
   // Automation and timing.
   int frame_count_ = 0;
@@ -212,6 +235,12 @@ class App {
   int frames_since_run_done_ = -1;
   int exit_code_ = 0;
   bool quit_now_ = false;
+  FrameStats frame_stats_;
+  // --frame-profile: milliseconds per stage summed over the profiled frames.
+  static constexpr int kProfileStages = 9;
+  double profile_ms_[kProfileStages] = {};
+  int profile_frames_ = 0;
+  std::chrono::steady_clock::time_point profile_last_;
 };
 
 }  // namespace qs::app

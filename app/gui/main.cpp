@@ -27,6 +27,22 @@ int main(int argc, char** argv) {
                  "Automation: draw a free-hand stroke (stroke tool) through the screen positions "
                  "of these mesh vertices, comma-separated; the first must hold a node")
       ->delimiter(',');
+  cli.add_flag("--bench-orbit", options.bench_orbit,
+               "Automation: orbit the camera a little every frame (the scene is re-rendered "
+               "every frame: the worst case for --bench-frames / --frames)");
+  cli.add_flag("!--no-scene-cache", options.scene_cache,
+               "Render the 3D scene every frame instead of reusing the last image while the "
+               "camera, the scene and the view settings are unchanged");
+  cli.add_option("--motion-resolution", options.motion_resolution,
+                 "Resolution scale of the 3D view while the camera moves, 0.25-1 (default 0.5; "
+                 "used without multisampling only; 1: always full resolution)")
+      ->check(CLI::Range(0.25f, 1.0f));
+  cli.add_option("--worker-nice", options.worker_nice,
+                 "Nice value of the solver threads, 0-19 (default 10: the UI wins the CPU; 0 "
+                 "leaves their priority alone)")
+      ->check(CLI::Range(0, 19));
+  cli.add_flag("--frame-profile", options.frame_profile,
+               "Print the mean time per frame stage (waiting for the GPU between stages) at exit");
   cli.add_option("--width", options.width, "Window width")->check(CLI::Range(200, 8192));
   cli.add_option("--height", options.height, "Window height")->check(CLI::Range(200, 8192));
   CLI11_PARSE(cli, argc, argv);

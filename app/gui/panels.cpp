@@ -454,17 +454,22 @@ void App::draw_quads_section() {
   if (!ImGui::CollapsingHeader("Quad mesh & export", ImGuiTreeNodeFlags_DefaultOpen)) return;
   ImGui::PushID("quads");
   // Quad size in surface units; 0 = automatic (about kDefaultQuadCount quads).
-  float diag = 1.0f;
-  if (doc_.mesh && doc_.mesh->n_vertices() > 0) {
-    glm::vec3 lo(1e30f), hi(-1e30f);
-    for (auto vh : doc_.mesh->vertices()) {
-      const auto& p = doc_.mesh->point(vh);
-      const glm::vec3 q{float(p[0]), float(p[1]), float(p[2])};
-      lo = glm::min(lo, q);
-      hi = glm::max(hi, q);
+  // The mesh's diagonal, once per mesh (not a loop over every vertex each frame).
+  if (mesh_diagonal_version_ != doc_.mesh_version) {
+    mesh_diagonal_version_ = doc_.mesh_version;
+    mesh_diagonal_ = 1.0f;
+    if (doc_.mesh && doc_.mesh->n_vertices() > 0) {
+      glm::vec3 lo(1e30f), hi(-1e30f);
+      for (auto vh : doc_.mesh->vertices()) {
+        const auto& p = doc_.mesh->point(vh);
+        const glm::vec3 q{float(p[0]), float(p[1]), float(p[2])};
+        lo = glm::min(lo, q);
+        hi = glm::max(hi, q);
+      }
+      mesh_diagonal_ = std::max(glm::length(hi - lo), 1e-6f);
     }
-    diag = std::max(glm::length(hi - lo), 1e-6f);
   }
+  const float diag = mesh_diagonal_;
   float quad_size = float(worker_options_.quad_size);
   char format[64];
   std::snprintf(format, sizeof(format), quad_size > 0.0f ? "q = %%.4g" : "auto (~%d quads)",
@@ -600,6 +605,7 @@ void App::draw_view_section() {
     mesh_layer_->reload(&shader_log_);
     layout_layer_->reload(&shader_log_);
     field_layer_->reload(&shader_log_);
+    scene_cache_.invalidate();  // the cached image was drawn with the old shaders
   }
   if (!shader_log_.empty()) ImGui::TextColored(kErrorColor, "%s", shader_log_.c_str());
   ImGui::SameLine();

@@ -25,6 +25,18 @@ if(TARGET gui_field_test)
   endif()
 endif()
 
+# gui_frame_test.cpp: frame statistics, solver thread priority (GL-free), plus the scene-cache
+# key of render/ when the app (and with it qs_render) is built.
+if(TARGET gui_frame_test)
+  target_sources(gui_frame_test PRIVATE
+    ${PROJECT_SOURCE_DIR}/app/gui/frame_stats.cpp
+    ${PROJECT_SOURCE_DIR}/app/gui/thread_priority.cpp)
+  if(TARGET qs_render)
+    target_link_libraries(gui_frame_test PRIVATE qs_render)
+    target_compile_definitions(gui_frame_test PRIVATE QS_TEST_RENDER)
+  endif()
+endif()
+
 if(NOT QS_BUILD_APP)
   return()
 endif()
@@ -70,6 +82,41 @@ if(CMAKE_VERSION VERSION_GREATER_EQUAL 3.19)
     set_tests_properties(gui_smoke_stroke_and_field PROPERTIES
       SKIP_RETURN_CODE 77 TIMEOUT 300 ENVIRONMENT "${QS_GUI_TEST_ENV}")
   endif()
+endif()
+
+# Redraw on demand while the camera moves: every frame re-renders the scene (at the reduced
+# motion resolution), and the picture must still show the surface with its wireframe and arcs.
+add_test(NAME gui_smoke_orbit
+  COMMAND gui_smoke_check screenshot --app $<TARGET_FILE:quadsketch>
+    --mesh ${QS_ASSETS_DIR}/example/ellipsoid.obj
+    --layout ${QS_ASSETS_DIR}/example/ellipsoid.layout.json
+    --out ${QS_GUI_SMOKE_DIR}/orbit.png --width 1280 --height 800
+    -- --bench-orbit)
+set_tests_properties(gui_smoke_orbit PROPERTIES
+  SKIP_RETURN_CODE 77 TIMEOUT 120 ENVIRONMENT "${QS_GUI_TEST_ENV}")
+
+# Redraw on demand, end to end (the app's own bench line): with a still camera the scene is
+# rendered during the warm-up only, so none of the timed frames re-renders it; orbiting
+# re-renders every timed frame. Needs xvfb-run (not registered without it).
+find_program(QS_XVFB_RUN xvfb-run)
+if(QS_XVFB_RUN)
+  foreach(qs_case still orbit)
+    if(qs_case STREQUAL "orbit")
+      set(qs_extra --bench-orbit)
+      set(qs_expect "scene rendered in 20 frames")
+    else()
+      set(qs_extra)
+      set(qs_expect "scene rendered in 0 frames")
+    endif()
+    add_test(NAME gui_bench_scene_cache_${qs_case}
+      COMMAND ${QS_XVFB_RUN} -a -s "-screen 0 1280x800x24" $<TARGET_FILE:quadsketch>
+        --mesh ${QS_ASSETS_DIR}/example/ellipsoid.obj
+        --layout ${QS_ASSETS_DIR}/example/ellipsoid.layout.json
+        --bench-frames 20 ${qs_extra} --quit)
+    set_tests_properties(gui_bench_scene_cache_${qs_case} PROPERTIES
+      PASS_REGULAR_EXPRESSION "bench: 20 frames.*${qs_expect}.*scene cache on"
+      TIMEOUT 120 ENVIRONMENT "${QS_GUI_TEST_ENV}")
+  endforeach()
 endif()
 
 # Bad input with --quit: message on stderr, exit code 2, no crash (and no display needed).
