@@ -145,6 +145,71 @@ TEST(CageLayout, TorusCageHasGenusOneAndABaseComplexLayout) {
   EXPECT_LT(worst, 0.01);  // the triangulated torus deviates from the ideal one by ~0.005
 }
 
+TEST(CageLayout, SubsampledCellsAreClassifiedByTheirInsideFraction) {
+  // A sphere of radius 1 on cells of 1/3: a cell is occupied exactly when at least half of its
+  // 4³ sample points are inside, so cells well inside are occupied and cells well outside
+  // empty; the surface is the same kind of manifold voxel surface of genus 0.
+  const TriMesh mesh = test::cube_sphere(24).mesh;
+  VoxelCageInfo info;
+  const PolyMesh cage = voxel_cage(mesh, 6, &info, 0.0, 4);
+  expect_cage_matches_voxels(cage, info, 0);
+  const VoxelGrid& g = info.grid;
+  int inside_fraction_mismatch = 0;
+  for (int k = 0; k < g.dims[2]; ++k)
+    for (int j = 0; j < g.dims[1]; ++j)
+      for (int i = 0; i < g.dims[0]; ++i) {
+        // Inside fraction of the cell, sampled like voxel_cage but against the ideal sphere.
+        int inside = 0;
+        for (int c = 0; c < 64; ++c) {
+          const Vec3 q =
+              g.origin +
+              Vec3(i + (c % 4 + 0.5) / 4, j + (c / 4 % 4 + 0.5) / 4, k + (c / 16 + 0.5) / 4) * g.h;
+          inside += q.norm() < 1.0;
+        }
+        // Cells clearly on one side (away from the 50% boundary, where the triangulated
+        // sphere and the ideal one may disagree) must be classified alike.
+        if (inside >= 40 && !g.at(i, j, k)) ++inside_fraction_mismatch;
+        if (inside <= 24 && g.at(i, j, k)) ++inside_fraction_mismatch;
+      }
+  EXPECT_EQ(inside_fraction_mismatch, 0);
+  EXPECT_EQ(info.flipped_cells, 0);  // no repair flip: the grid is the sampled classification
+  try {
+    voxel_cage(mesh, 6, nullptr, 0.0, 9);
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("subsamples"), std::string::npos) << e.what();
+  }
+}
+
+TEST(CageLayout, RefinedFittedCageStaysOnTheSurface) {
+  const TriMesh mesh = test::torus_grid(96, 32, 1, 1).mesh;
+  VoxelCageInfo info;
+  PolyMesh cage = voxel_cage(mesh, 10, &info);
+  ASSERT_EQ(info.genus, 1);
+  fit_cage(cage, mesh);
+  const PolyMesh fitted = cage;
+  refine_fitted_cage(cage, mesh);
+  EXPECT_TRUE(is_pure_quad(cage));
+  EXPECT_EQ(cage.n_faces(), 4 * fitted.n_faces());
+  MeshReport report;
+  count_topology(cage, report);
+  EXPECT_EQ(report.genus, 1);
+  EXPECT_EQ(report.components, 1);
+  // Original vertices keep their positions; new ones lie on the torus (radii 2 and 0.7).
+  double moved = 0, worst = 0;
+  for (const auto v : cage.vertices()) {
+    const Vec3 p = cage.point(v);
+    if (static_cast<size_t>(v.idx()) < fitted.n_vertices())
+      moved = std::max(moved, (p - fitted.point(v)).norm());
+    const double rho = std::hypot(p[0], p[1]) - 2.0;
+    worst = std::max(worst, std::abs(std::hypot(rho, p[2]) - 0.7));
+  }
+  EXPECT_EQ(moved, 0.0);
+  EXPECT_LT(worst, 0.01);
+  // The base complex keeps its nodes: split vertices are regular.
+  EXPECT_EQ(base_complex(cage).node_vertex.size(), base_complex(fitted).node_vertex.size());
+}
+
 TEST(CageLayout, RefusesMeshesWithBoundaryAndWrongResolutions) {
   const TriMesh disk = test::disk_grid(8, 8, 2, 2).mesh;
   EXPECT_THROW(cage_layout(disk), InvalidInputError);

@@ -12,6 +12,7 @@
 #include <map>
 #include <set>
 
+#include "core/field/cross_field.h"
 #include "core/layout/routing.h"
 #include "core/mesh/mesh_checks.h"
 
@@ -466,6 +467,60 @@ void write_obj(const TriMesh& mesh, const std::string& path) {
 
 void write_obj(const PolyMesh& mesh, const std::string& path) {
   write_obj_text(mesh, path);
+}
+
+FieldIndexCheck check_field_indices(const TriMesh& mesh, const GeometryCache& geometry,
+                                    const Layout& layout, const LayoutTopology& topology,
+                                    const std::vector<double>& theta) {
+  FieldIndexCheck check;
+  const std::vector<int> indices = field_quarter_indices(geometry, theta);
+  std::vector<int> expected(mesh.n_vertices(), 0);
+  std::vector<char> is_node(mesh.n_vertices(), 0);
+  for (int n = 0; n < topology.num_nodes; ++n) {
+    expected[layout.nodes[n].vertex] = 4 - topology.valence[n];
+    is_node[layout.nodes[n].vertex] = 1;
+    check.irregular += topology.valence[n] != 4;
+  }
+  for (const auto v : mesh.vertices()) {
+    check.sum += indices[v.idx()];
+    if (mesh.is_boundary(v) || indices[v.idx()] == expected[v.idx()]) continue;
+    ++check.wrong;
+    check.spurious += !is_node[v.idx()];
+    if (check.examples.size() < 5) {
+      check.examples.push_back("vertex " + std::to_string(v.idx()) + ": index " +
+                               std::to_string(indices[v.idx()]) + "/4, expected " +
+                               std::to_string(expected[v.idx()]) + "/4");
+    }
+  }
+  return check;
+}
+
+EmbeddingCheck check_embedding(const TriMesh& mesh, const GeometryCache& geometry,
+                               const LayoutTopology& topology, const Extraction& extraction,
+                               const std::vector<std::array<double, 2>>& corner_uv) {
+  EmbeddingCheck check;
+  for (const TracedArc& t : extraction.arcs) {
+    for (size_t i = 0; i + 1 < t.samples.size(); ++i) {
+      // Both samples lie on the face of the second one (the face the segment crosses).
+      const int f = t.samples[i + 1].face;
+      const auto p0 = uv_in_face(mesh, geometry, corner_uv, t.samples[i], f);
+      const auto p1 = uv_in_face(mesh, geometry, corner_uv, t.samples[i + 1], f);
+      const double du = std::abs(p1[0] - p0[0]), dv = std::abs(p1[1] - p0[1]);
+      const double moving = std::max(du, dv), fixed = std::min(du, dv);
+      if (moving > 1e-12) check.iso_violation = std::max(check.iso_violation, fixed / moving);
+    }
+  }
+  for (const auto& patch : topology.patches) {
+    if (patch.darts.size() != 4) continue;
+    for (int k = 0; k < 2; ++k) {
+      const double a = extraction.arcs[patch.darts[k] >> 1].param_length;
+      const double b = extraction.arcs[patch.darts[k + 2] >> 1].param_length;
+      const double scale = std::max(a, b);
+      if (scale > 0) check.side_mismatch = std::max(check.side_mismatch, std::abs(a - b) / scale);
+      ++check.sides_checked;
+    }
+  }
+  return check;
 }
 
 }  // namespace qs::test

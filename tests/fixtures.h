@@ -5,7 +5,9 @@
 #include <string>
 #include <vector>
 
+#include "core/extract/tracing.h"
 #include "core/layout/layout.h"
+#include "core/mesh/geometry.h"
 #include "core/mesh/mesh.h"
 
 namespace qs::test {
@@ -95,5 +97,38 @@ MaskStar mask_star(const TriMesh& mesh);
 void write_obj(const TriMesh& mesh, const std::string& path);
 //! The same for a polygon mesh (one `f` line per face, any number of corners).
 void write_obj(const PolyMesh& mesh, const std::string& path);
+
+//! Singularities of a cross field measured on the field alone (field_quarter_indices:
+//! principal matching + angle defect, independent of the layout's period jumps), compared with
+//! the layout: index (4 − valence)/4 at every interior node vertex, 0 at every other interior
+//! vertex.
+struct FieldIndexCheck {
+  int wrong = 0;      //!< interior vertices whose measured index differs from the expected one
+  int spurious = 0;   //!< of them, vertices that are not node vertices
+  int sum = 0;        //!< sum of the measured indices over all vertices (quarter turns)
+  int irregular = 0;  //!< nodes of valence != 4
+  std::vector<std::string> examples;  //!< the first 5 wrong vertices, described
+};
+
+//! \p theta: the field per face (CrossField::theta), size #F.
+FieldIndexCheck check_field_indices(const TriMesh& mesh, const GeometryCache& geometry,
+                                    const Layout& layout, const LayoutTopology& topology,
+                                    const std::vector<double>& theta);
+
+//! Embedding checks of issue #4 on traced arcs (no GoogleTest: callers assert).
+struct EmbeddingCheck {
+  //! Worst ratio (smaller / larger parameter change) between consecutive samples of a traced
+  //! arc inside one face, in that face's chart: 0 for exact iso-lines.
+  double iso_violation = 0;
+  //! Worst |l0 − l2| / max(l0, l2) over the opposite sides of every 4-sided patch (parametric
+  //! arc lengths).
+  double side_mismatch = 0;
+  int sides_checked = 0;  //!< pairs of opposite sides compared
+};
+
+//! \p corner_uv: Parameterization::corner_uv (size 3·#F).
+EmbeddingCheck check_embedding(const TriMesh& mesh, const GeometryCache& geometry,
+                               const LayoutTopology& topology, const Extraction& extraction,
+                               const std::vector<std::array<double, 2>>& corner_uv);
 
 }  // namespace qs::test

@@ -6,8 +6,11 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <limits>
 
 #include "core/base/errors.h"
+#include "core/layout/patch_import.h"
 #include "core/layout/validate.h"
 #include "core/mesh/closest_point.h"
 #include "core/mesh/mesh_io.h"
@@ -249,6 +252,61 @@ TEST_F(RealQuads, DenseComplexOntoCoarseTargetFailsClearly) {
   }
 }
 
+TEST_F(RealQuads, JointOntoItsTriangleMeshViaQuadWildPatches) {
+  // The joint's base complex spirals (3751 nodes) and cannot be transferred onto the coarser
+  // joint_rem_p.obj (4387 vertices); the import then falls back to QuadWild's own patches of that
+  // mesh, split into quads.
+  const std::string base = dir_ + "/quadwild_joint/joint_rem_p";
+  const PolyMesh quads = load_poly_mesh(base + "_quadrangulation.obj");
+  const TriMesh target = load_mesh(base + ".obj");
+  const PatchPartition partition =
+      load_quadwild_partition(target, base + ".patch", base + ".corners");
+  QuadImportOptions options;
+  options.target_partition = &partition;
+  const QuadImportResult r = import_quads(quads, &target, options);
+  ASSERT_TRUE(r.via_partition);
+  ASSERT_FALSE(r.warnings.empty());
+  EXPECT_NE(r.warnings.back().find("patch partition"), std::string::npos) << r.warnings.back();
+  const ValidationResult vr = validate_layout(r.mesh, r.layout);
+  ASSERT_TRUE(vr.valid()) << (vr.issues.empty() ? "" : format_issue(vr.issues[0]));
+  // Patch count and node valences are those of the partition's own quad layout.
+  PatchLayoutStats stats;
+  const Layout direct = layout_from_partition(target, partition, &stats);
+  const LayoutTopology topo = build_topology(r.mesh, r.layout);
+  EXPECT_EQ(static_cast<int>(topo.patches.size()), stats.expected_patches);
+  EXPECT_EQ(topo.valence, build_topology(target, direct).valence);
+  EXPECT_EQ(topo.num_nodes - topo.num_arcs + static_cast<int>(topo.patches.size()), -2);
+  // The patch corners are vertices of the quadrangulation (its patches' corners): every corner
+  // node lies within one mean target edge length of a quad-mesh vertex.
+  double sum = 0;
+  for (const auto e : target.edges()) sum += target.calc_edge_length(e);
+  const double mean_edge = sum / target.n_edges();
+  ASSERT_GT(stats.partition_nodes, 0);
+  for (int n = 0; n < stats.partition_nodes; ++n) {
+    const Vec3 p = target.point(VH(r.layout.nodes[n].vertex));
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const auto v : quads.vertices()) nearest = std::min(nearest, (quads.point(v) - p).norm());
+    EXPECT_LE(nearest, mean_edge) << "node " << n;
+  }
+  // Without the partition the transfer fails as before (see DenseComplexOntoCoarseTarget...).
+  EXPECT_THROW(import_quads(quads, &target, {}), InvalidInputError);
+}
+
+TEST_F(RealQuads, CliPicksUpQuadWildPatchesBesideTheTarget) {
+  // import-quads --onto T uses T.patch / T.corners when the base complex cannot be transferred.
+  const std::string base = dir_ + "/quadwild_joint/joint_rem_p";
+  const std::string out = test::temp_dir("import_quads_quadwild");
+  ASSERT_EQ(test::run_command(test::cli_path() + " import-quads --quiet --quads " + base +
+                              "_quadrangulation.obj --onto " + base + ".obj --out " + out),
+            0);
+  std::ifstream in(out + "/report.json");
+  const std::string report((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(report.find("\"partition\""), std::string::npos) << report;
+  EXPECT_EQ(test::run_command(test::cli_path() + " validate --mesh " + out + "/mesh.obj --layout " +
+                              out + "/layout.json"),
+            0);
+}
+
 TEST_F(RealQuads, InspiredCoarsenedOntoItsTriangleMesh) {
   // The staircase boundary makes almost every vertex a node of the base complex; collapsing its
   // thin chords makes the transfer onto the (boundary) triangle mesh possible.
@@ -271,6 +329,182 @@ TEST_F(RealQuads, InspiredCoarsenedOntoItsTriangleMesh) {
     FAIL() << "expected InvalidInputError";
   } catch (const InvalidInputError& e) {
     EXPECT_NE(std::string(e.what()).find("--coarsen"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(RealQuads, QuadWildPatchesOfTheJointSplitIntoQuads) {
+  // QuadWild's own patches of joint_rem_p.obj (25 quads, 12 pentagons), each n-gon split into n
+  // quads on the triangle mesh itself: a valid genus-2 layout with one patch per side.
+  const std::string base = dir_ + "/quadwild_joint/joint_rem_p";
+  const TriMesh mesh = load_mesh(base + ".obj");
+  const PatchPartition partition =
+      load_quadwild_partition(mesh, base + ".patch", base + ".corners");
+  PatchLayoutStats stats;
+  const Layout layout = layout_from_partition(mesh, partition, &stats);
+  const ValidationResult vr = validate_layout(mesh, layout);
+  ASSERT_TRUE(vr.valid()) << (vr.issues.empty() ? "" : format_issue(vr.issues[0]));
+  const LayoutTopology topo = build_topology(mesh, layout);
+  ASSERT_EQ(stats.partition_patches, static_cast<int>(partition.corners.size()));
+  EXPECT_EQ(static_cast<int>(topo.patches.size()), stats.expected_patches);
+  int n_centres = 0;
+  for (const auto& centres : stats.centres) n_centres += static_cast<int>(centres.size());
+  EXPECT_EQ(topo.num_nodes, stats.partition_nodes + stats.partition_arcs + n_centres);
+  EXPECT_EQ(topo.num_nodes - topo.num_arcs + static_cast<int>(topo.patches.size()), -2);
+  // Every listed corner is a node; every side midpoint joins its two halves and one or two
+  // centres on each side (two where a patch needed two centres, valence 4..6); a single centre
+  // has one arc per side, two centres have k + 2 arc ends together.
+  std::vector<int> node_of_vertex(mesh.n_vertices(), -1);
+  for (size_t n = 0; n < layout.nodes.size(); ++n) node_of_vertex[layout.nodes[n].vertex] = n;
+  for (const auto& corners : partition.corners)
+    for (int v : corners) EXPECT_GE(node_of_vertex[v], 0) << "corner vertex " << v;
+  const int first_mid = stats.partition_nodes, first_centre = first_mid + stats.partition_arcs;
+  for (int n = first_mid; n < first_centre; ++n) {
+    EXPECT_GE(topo.valence[n], 4) << "node " << n;
+    EXPECT_LE(topo.valence[n], 6) << "node " << n;
+  }
+  int two_centres = 0;
+  for (int p = 0; p < stats.partition_patches; ++p) {
+    const auto& centres = stats.centres[p];
+    ASSERT_TRUE(centres.size() == 1 || centres.size() == 2) << "patch " << p;
+    int ends = 0;
+    for (int c : centres) {
+      ends += topo.valence[c];
+      // A centre lies inside its patch.
+      for (const auto f : mesh.vf_range(VH(layout.nodes[c].vertex)))
+        EXPECT_EQ(partition.face_patch[f.idx()], p) << "centre of patch " << p;
+    }
+    EXPECT_EQ(ends, stats.sides[p] + (centres.size() == 2 ? 2 : 0)) << "patch " << p;
+    EXPECT_EQ(stats.quads[p], stats.sides[p] + (centres.size() == 2 ? 1 : 0)) << "patch " << p;
+    two_centres += centres.size() == 2;
+  }
+  EXPECT_LE(two_centres, 3);
+  // Every quad lies inside one QuadWild patch.
+  std::vector<int> owner(topo.patches.size(), -1);
+  for (size_t f = 0; f < mesh.n_faces(); ++f) {
+    const int q = topo.face_patch[f];
+    ASSERT_GE(q, 0);
+    if (owner[q] < 0) owner[q] = partition.face_patch[f];
+    EXPECT_EQ(owner[q], partition.face_patch[f]) << "face " << f;
+  }
+}
+
+TEST(PatchImport, CubeFacesSplitIntoFourQuadsEach) {
+  // The six faces of a triangulated cube as patches (corners derived: the 8 vertices where
+  // three patches meet): 6 × 4 quads, nodes = 8 corners + 12 side midpoints + 6 centres.
+  const TriMesh mesh = triangulate_quads(quad_cube(4), 2);
+  PatchPartition partition;
+  partition.corners.assign(6, {});
+  for (const auto f : mesh.faces()) {
+    const Vec3 n = mesh.calc_face_normal(f);
+    int axis = 0;
+    for (int i = 1; i < 3; ++i)
+      if (std::abs(n[i]) > std::abs(n[axis])) axis = i;
+    partition.face_patch.push_back(2 * axis + (n[axis] > 0 ? 1 : 0));
+  }
+  PatchLayoutStats stats;
+  const Layout layout = layout_from_partition(mesh, partition, &stats);
+  const ValidationResult vr = validate_layout(mesh, layout);
+  ASSERT_TRUE(vr.valid()) << (vr.issues.empty() ? "" : format_issue(vr.issues[0]));
+  const LayoutTopology topo = build_topology(mesh, layout);
+  EXPECT_EQ(stats.partition_nodes, 8);
+  EXPECT_EQ(stats.partition_arcs, 12);
+  EXPECT_EQ(stats.expected_patches, 24);
+  EXPECT_EQ(static_cast<int>(topo.patches.size()), 24);
+  EXPECT_EQ(topo.num_nodes, 26);
+  EXPECT_EQ(topo.num_arcs, 48);
+  for (int n = 0; n < 8; ++n) EXPECT_EQ(topo.valence[n], 3) << "corner " << n;
+  for (int n = 8; n < 26; ++n) EXPECT_EQ(topo.valence[n], 4) << "node " << n;
+  // Each quad lies in one cube face; each face holds four.
+  std::vector<int> owner(topo.patches.size(), -1), count(6, 0);
+  for (size_t f = 0; f < mesh.n_faces(); ++f) {
+    const int q = topo.face_patch[f];
+    if (owner[q] < 0) owner[q] = partition.face_patch[f], ++count[owner[q]];
+    EXPECT_EQ(owner[q], partition.face_patch[f]);
+  }
+  for (int c : count) EXPECT_EQ(c, 4);
+  // As an import fallback the partition is used only when the transfer fails, and never for a
+  // quad mesh that does not lie on the target.
+  QuadImportOptions options;
+  options.target_partition = &partition;
+  EXPECT_FALSE(import_quads(quad_cube(4), &mesh, options).via_partition);
+  EXPECT_THROW(import_quads(quad_cube(4, Vec3(100, 0, 0)), &mesh, options), InvalidInputError);
+}
+
+TEST(PatchImport, RandomPartitionsGiveValidLayoutsOrClearErrors) {
+  // Grown random partitions of a triangulated cube (patches of any shape and side count, some
+  // not disks): the result is a valid layout with one quad per side (k + 1 with two centres),
+  // or an InvalidInputError (anything else fails the test).
+  const TriMesh mesh = triangulate_quads(quad_cube(6), 2);
+  const int nf = static_cast<int>(mesh.n_faces());
+  int built = 0;
+  for (unsigned seed = 1; seed <= 40; ++seed) {
+    const int n_patches = 3 + static_cast<int>(seed % 9);
+    PatchPartition partition;
+    partition.corners.assign(n_patches, {});
+    partition.face_patch.assign(nf, -1);
+    std::vector<int> queue;
+    unsigned state = seed * 2654435761u;
+    auto next = [&] { return state = state * 1664525u + 1013904223u; };
+    for (int p = 0; p < n_patches; ++p) {
+      int f = static_cast<int>(next() % nf);
+      while (partition.face_patch[f] >= 0) f = (f + 1) % nf;
+      partition.face_patch[f] = p;
+      queue.push_back(f);
+    }
+    for (size_t head = 0; head < queue.size(); ++head) {
+      const int f = queue[head];
+      for (const auto g : mesh.ff_range(OpenMesh::FaceHandle(f))) {
+        if (partition.face_patch[g.idx()] >= 0) continue;
+        partition.face_patch[g.idx()] = partition.face_patch[f];
+        queue.push_back(g.idx());
+      }
+    }
+    try {
+      PatchLayoutStats stats;
+      const Layout layout = layout_from_partition(mesh, partition, &stats);
+      ASSERT_TRUE(validate_layout(mesh, layout).valid()) << "seed " << seed;
+      EXPECT_EQ(static_cast<int>(build_topology(mesh, layout).patches.size()),
+                stats.expected_patches)
+          << "seed " << seed;
+      ++built;
+    } catch (const InvalidInputError&) {
+      // e.g. a side of a single edge or a patch whose interior is pinched: named in the message
+    }
+  }
+  EXPECT_GE(built, 10);  // 20 of the 40 at the time of writing
+}
+
+TEST(PatchImport, MalformedPartitionFilesAreClearErrors) {
+  const std::string dir = test::temp_dir("patch_import_bad");
+  const TriMesh mesh = triangulate_quads(quad_cube(2), 2);
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir + "/" + name) << text;
+    return dir + "/" + name;
+  };
+  const std::string corners = write("c.corners", "1\n3\n0 1 2\n");
+  // Wrong face count, patch id out of range, vertex out of range, missing file.
+  EXPECT_THROW(load_quadwild_partition(mesh, write("a.patch", "3\n0 0 0\n"), corners),
+               InvalidInputError);
+  std::string ids = std::to_string(mesh.n_faces()) + "\n";
+  for (size_t f = 0; f < mesh.n_faces(); ++f) ids += (f == 5 ? "7\n" : "0\n");
+  EXPECT_THROW(load_quadwild_partition(mesh, write("b.patch", ids), corners), InvalidInputError);
+  EXPECT_THROW(
+      load_quadwild_partition(mesh, write("b.patch", ids), write("d.corners", "1\n3\n0 1 99999\n")),
+      InvalidInputError);
+  EXPECT_THROW(load_quadwild_partition(mesh, dir + "/missing.patch", corners), InvalidInputError);
+  // A corners file announcing more patches than it holds.
+  EXPECT_THROW(
+      load_quadwild_partition(mesh, write("b.patch", ids), write("e.corners", "2\n3\n0 1 2\n")),
+      InvalidInputError);
+  // A single patch covering the closed cube is not a disk.
+  PatchPartition one;
+  one.face_patch.assign(mesh.n_faces(), 0);
+  one.corners = {{0, 1, 2}};
+  try {
+    layout_from_partition(mesh, one);
+    FAIL() << "expected InvalidInputError";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("patch 0"), std::string::npos) << e.what();
   }
 }
 

@@ -119,6 +119,12 @@ int main(int argc, char** argv) {
                    "Collapse cage chords at most this many voxel cells wide (0: off)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  cmd_cage
+      ->add_option("--subsamples", cage.subsamples,
+                   "Inside-test points per cell and axis (1: the cell centre; more: the cell's "
+                   "inside fraction)")
+      ->check(CLI::Range(1, 8))
+      ->capture_default_str();
   cmd_cage->add_option("--cage", cage.cage, "Also write the fitted quad cage (OBJ)");
 
   try {

@@ -3,6 +3,8 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
+#include <string>
 
 #include "app/cli/commands.h"
 #include "app/cli/report.h"
@@ -31,6 +33,12 @@ void write_cage_obj(const PolyMesh& cage, const std::string& path) {
   });
 }
 
+std::string format_shift(double shift) {
+  std::ostringstream os;
+  os << std::setprecision(3) << shift;
+  return os.str();
+}
+
 }  // namespace
 
 int run_cage_layout(const CageLayoutOptions& o, const CommonOptions& common) {
@@ -42,6 +50,7 @@ int run_cage_layout(const CageLayoutOptions& o, const CommonOptions& common) {
   options.all_edges = o.all_edges;
   options.coarsen = o.coarsen;
   options.fit.iterations = o.smoothing;
+  options.subsamples = o.subsamples;
   const CageResult result = cage_layout(mesh, options);
   for (const auto& w : result.warnings) std::cerr << "warning: " << w << "\n";
   const auto parent = std::filesystem::path(o.out).parent_path();
@@ -54,9 +63,11 @@ int run_cage_layout(const CageLayoutOptions& o, const CommonOptions& common) {
   }
   if (!common.quiet) {
     const nlohmann::json counts = layout_json(build_topology(mesh, result.layout));
-    std::cerr << "cage-layout: resolution " << result.resolution << ", cage "
-              << result.cage.n_faces() << " quads (genus " << result.voxels.genus << ", "
-              << result.voxels.flipped_cells << " cells flipped for manifoldness, "
+    std::cerr << "cage-layout: resolution " << result.resolution
+              << (result.shift != 0 ? " (shifted " + format_shift(result.shift) + " cell)" : "")
+              << (result.refined ? ", split " + std::to_string(result.refined) + "x" : "")
+              << ", cage " << result.cage.n_faces() << " quads (genus " << result.voxels.genus
+              << ", " << result.voxels.flipped_cells << " cells flipped for manifoldness, "
               << result.folded_quads << " folded after fitting, " << result.coarsen.patches_before
               << " patches before coarsening); layout " << counts["nodes"] << " nodes ("
               << counts["irregular_nodes"] << " irregular), " << counts["arcs"] << " arcs, "

@@ -9,6 +9,7 @@
 #include "core/base/atomic_file.h"
 #include "core/base/errors.h"
 #include "core/layout/layout_io.h"
+#include "core/layout/patch_import.h"
 #include "core/layout/perturb.h"
 #include "core/layout/quad_import.h"
 #include "core/layout/validate.h"
@@ -62,6 +63,26 @@ int run_import_quads(const ImportQuadsOptions& o, const CommonOptions& common) {
     options.all_edges = o.all_edges;
     options.refine = o.refine;
     options.coarsen = o.coarsen;
+    // QuadWild's own patches of the --onto mesh (<stem>.patch and <stem>.corners beside it):
+    // the layout falls back to them when the base complex cannot be transferred.
+    PatchPartition partition;
+    std::string partition_files;
+    if (!o.onto.empty()) {
+      std::filesystem::path stem(o.onto);
+      stem.replace_extension();
+      const std::string patch_file = stem.string() + ".patch";
+      const std::string corners_file = stem.string() + ".corners";
+      if (std::filesystem::exists(patch_file) && std::filesystem::exists(corners_file)) {
+        try {
+          partition = load_quadwild_partition(target, patch_file, corners_file);
+          options.target_partition = &partition;
+          partition_files = patch_file + ", " + corners_file;
+        } catch (const InvalidInputError& e) {
+          std::cerr << "warning: ignoring the patch partition beside " << o.onto << ": " << e.what()
+                    << "\n";
+        }
+      }
+    }
     const auto t_import = std::chrono::steady_clock::now();
     const QuadImportResult result =
         import_quads(quads, o.onto.empty() ? nullptr : &target, options);
@@ -95,6 +116,13 @@ int run_import_quads(const ImportQuadsOptions& o, const CommonOptions& common) {
                             {{"nodes", result.coarsen.nodes_after},
                              {"arcs", result.coarsen.arcs_after},
                              {"patches", result.coarsen.patches_after}}}};
+    }
+    if (result.via_partition) {
+      report["partition"] = {{"files", partition_files},
+                             {"patches", result.partition_stats.partition_patches},
+                             {"corners", result.partition_stats.partition_nodes},
+                             {"sides", result.partition_stats.partition_arcs},
+                             {"quads", result.partition_stats.expected_patches}};
     }
     report["timings_s"] = {
         {"load", load_s}, {"import", import_s}, {"total", seconds_since(t_total)}};

@@ -48,6 +48,7 @@ struct CageLayoutOptions {
   int smoothing = 30;      //!< spring relaxation rounds of the fitted cage (CageFitOptions)
   bool all_edges = false;  //!< every cage edge is an arc (one patch per cage quad)
   double coarsen = 1.5;    //!< collapse cage chords at most this many voxel cells wide (0: off)
+  int subsamples = 1;      //!< inside-test points per cell and axis (CageOptions::subsamples)
 };
 
 struct PerturbOptions {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -209,7 +210,8 @@ std::string attempt_text(int resolution, const std::string& what) {
 
 }  // namespace
 
-PolyMesh voxel_cage(const TriMesh& mesh, int resolution, VoxelCageInfo* info, double shift) {
+PolyMesh voxel_cage(const TriMesh& mesh, int resolution, VoxelCageInfo* info, double shift,
+                    int subsamples) {
   if (mesh.n_faces() == 0) throw InvalidInputError("the mesh has no faces");
   for (const auto e : mesh.edges()) {
     if (mesh.is_boundary(e)) {
@@ -219,6 +221,12 @@ PolyMesh voxel_cage(const TriMesh& mesh, int resolution, VoxelCageInfo* info, do
   }
   if (resolution < 2 || resolution > 200) {
     throw InvalidInputError("the cage resolution must be between 2 and 200 cells (got " +
+                            std::to_string(resolution) + ")");
+  }
+  if (subsamples < 1 || subsamples > 8 || resolution * subsamples > 400) {
+    throw InvalidInputError("the cage subsamples must be between 1 and 8, with resolution × " +
+                            std::string("subsamples at most 400 (got ") +
+                            std::to_string(subsamples) + " at resolution " +
                             std::to_string(resolution) + ")");
   }
   const double inf = std::numeric_limits<double>::infinity();
@@ -243,11 +251,25 @@ PolyMesh voxel_cage(const TriMesh& mesh, int resolution, VoxelCageInfo* info, do
     if (shift != 0) g.dims[a] += 1;
   }
   g.occupied.assign(static_cast<size_t>(g.dims[0]) * g.dims[1] * g.dims[2], 0);
-  std::vector<uint8_t> votes(g.occupied.size(), 0);
-  for (int a = 0; a < 3; ++a) parity_votes(mesh, g, a, votes);
-  for (size_t c = 0; c < votes.size(); ++c) {
-    g.occupied[c] = votes[c] >= 2;
-    out.inside_cells += g.occupied[c];
+  {
+    // Inside test on the sample grid (the cells split subsamples³ times), counted per cell.
+    const int s = subsamples;
+    VoxelGrid samples;
+    samples.h = g.h / s;
+    samples.origin = g.origin;
+    for (int a = 0; a < 3; ++a) samples.dims[a] = g.dims[a] * s;
+    std::vector<uint8_t> votes(
+        static_cast<size_t>(samples.dims[0]) * samples.dims[1] * samples.dims[2], 0);
+    for (int a = 0; a < 3; ++a) parity_votes(mesh, samples, a, votes);
+    std::vector<int> inside(g.occupied.size(), 0);
+    for (int k = 0; k < samples.dims[2]; ++k)
+      for (int j = 0; j < samples.dims[1]; ++j)
+        for (int i = 0; i < samples.dims[0]; ++i)
+          if (votes[samples.cell(i, j, k)] >= 2) ++inside[g.cell(i / s, j / s, k / s)];
+    for (size_t c = 0; c < inside.size(); ++c) {
+      g.occupied[c] = inside[c] > 0 && 2 * inside[c] >= s * s * s;
+      out.inside_cells += g.occupied[c];
+    }
   }
   if (out.inside_cells == 0) {
     throw InvalidInputError(attempt_text(
@@ -442,6 +464,22 @@ Vec3 cage_vertex_normal(const PolyMesh& cage, VH v) {
 
 }  // namespace
 
+void refine_fitted_cage(PolyMesh& cage, const TriMesh& mesh) {
+  const size_t old_vertices = cage.n_vertices();
+  if (old_vertices == 0) return;
+  double mean_edge = 0;
+  for (const auto e : cage.edges()) mean_edge += cage.calc_edge_length(e);
+  mean_edge /= std::max<size_t>(1, cage.n_edges());
+  cage = split_to_quads(cage);
+  SidedProjector projector(mesh, 0.5 * mean_edge);
+  std::vector<Vec3> normal(cage.n_vertices());
+  for (const auto v : cage.vertices()) normal[v.idx()] = cage_vertex_normal(cage, v);
+  for (const auto v : cage.vertices()) {
+    if (static_cast<size_t>(v.idx()) < old_vertices) continue;
+    cage.set_point(v, projector.project(cage.point(v), normal[v.idx()], 1.5 * mean_edge).point);
+  }
+}
+
 int fit_cage(PolyMesh& cage, const TriMesh& mesh, const CageFitOptions& options) {
   const size_t nv = cage.n_vertices();
   if (nv == 0) return 0;
@@ -536,13 +574,15 @@ CageResult cage_layout(const TriMesh& mesh, const CageOptions& options) {
   bc.all_edges = options.all_edges;
   for (int attempt = 0; attempt < std::max(1, options.attempts); ++attempt) {
     const int resolution = options.resolution + attempt / 2;
-    const double shift = attempt % 2 ? 0.5 : 0.0;
+    double shift = options.shift + (attempt % 2 ? 0.5 : 0.0);
+    shift -= std::floor(shift);
     if (resolution > 200) break;
-    const std::string name =
-        "resolution " + std::to_string(resolution) + (shift != 0 ? " (shifted)" : "");
+    char shift_text[32] = "";
+    if (shift != 0) std::snprintf(shift_text, sizeof shift_text, " (shifted %.3g)", shift);
+    const std::string name = "resolution " + std::to_string(resolution) + shift_text;
     PolyMesh cage;
     try {
-      cage = voxel_cage(mesh, resolution, &result.voxels, shift);
+      cage = voxel_cage(mesh, resolution, &result.voxels, shift, options.subsamples);
     } catch (const InvalidInputError& e) {
       failures.push_back(e.what());
       continue;
@@ -555,41 +595,51 @@ CageResult cage_layout(const TriMesh& mesh, const CageOptions& options) {
       continue;
     }
     const int folded = fit_cage(cage, mesh, options.fit);
-    const QuadComplex full = base_complex(cage, bc);
-    // The coarsened complex first (when asked for), then the cage's full complex.
-    std::vector<std::pair<QuadComplex, CoarsenStats>> candidates;
-    if (options.coarsen > 0 && !options.all_edges) {
-      CoarsenOptions co;
-      co.max_width = options.coarsen * result.voxels.grid.h;
-      CoarsenStats stats;
-      QuadComplex coarse = coarsen_complex(cage, full, co, &stats);
-      if (stats.chords_collapsed > 0) candidates.emplace_back(std::move(coarse), stats);
-    }
-    CoarsenStats plain;
-    plain.nodes_before = plain.nodes_after = static_cast<int>(full.node_vertex.size());
-    plain.arcs_before = plain.arcs_after = static_cast<int>(full.arcs.size());
-    plain.patches_before = plain.patches_after = full.num_patches;
-    candidates.emplace_back(full, plain);
-    int chosen = -1;
-    for (size_t k = 0; k < candidates.size() && chosen < 0; ++k) {
-      try {
-        result.layout = transfer_complex(cage, candidates[k].first, mesh, options.transfer);
-        chosen = static_cast<int>(k);
-      } catch (const InvalidInputError& e) {
-        // import-quads' hint about its --coarsen option does not apply here.
-        std::string why = e.what();
-        why = why.substr(0, why.find("; --coarsen"));
-        failures.push_back(name + ": " + std::to_string(cage.n_faces()) + " cage quads, " +
-                           std::to_string(candidates[k].first.num_patches) + " patches" +
-                           (candidates[k].second.chords_collapsed ? " (coarsened)" : "") + ", " +
-                           std::to_string(folded) + " folded; transfer failed: " + why);
+    int chosen = -1, refined = 0;
+    QuadComplex complex;
+    CoarsenStats stats;
+    // Splitting adds arcs in all-edges mode (one patch per quad), so it is for complexes only.
+    const int max_refine = options.all_edges ? 0 : std::max(0, options.max_refine);
+    for (; refined <= max_refine && chosen < 0; ++refined) {
+      if (refined > 0) refine_fitted_cage(cage, mesh);
+      const std::string level = refined ? " (split " + std::to_string(refined) + "x)" : "";
+      const QuadComplex full = base_complex(cage, bc);
+      // The coarsened complex first (when asked for), then the cage's full complex.
+      std::vector<std::pair<QuadComplex, CoarsenStats>> candidates;
+      if (options.coarsen > 0 && !options.all_edges) {
+        CoarsenOptions co;
+        co.max_width = options.coarsen * result.voxels.grid.h;
+        CoarsenStats coarse_stats;
+        QuadComplex coarse = coarsen_complex(cage, full, co, &coarse_stats);
+        if (coarse_stats.chords_collapsed > 0)
+          candidates.emplace_back(std::move(coarse), coarse_stats);
+      }
+      CoarsenStats plain;
+      plain.nodes_before = plain.nodes_after = static_cast<int>(full.node_vertex.size());
+      plain.arcs_before = plain.arcs_after = static_cast<int>(full.arcs.size());
+      plain.patches_before = plain.patches_after = full.num_patches;
+      candidates.emplace_back(full, plain);
+      for (size_t k = 0; k < candidates.size() && chosen < 0; ++k) {
+        try {
+          result.layout = transfer_complex(cage, candidates[k].first, mesh, options.transfer);
+          chosen = static_cast<int>(k);
+          complex = std::move(candidates[k].first);
+          stats = candidates[k].second;
+        } catch (const InvalidInputError& e) {
+          // import-quads' hint about its --coarsen option does not apply here.
+          std::string why = e.what();
+          why = why.substr(0, why.find("; --coarsen"));
+          failures.push_back(name + ": " + std::to_string(cage.n_faces()) + " cage quads" + level +
+                             ", " + std::to_string(candidates[k].first.num_patches) + " patches" +
+                             (candidates[k].second.chords_collapsed ? " (coarsened)" : "") + ", " +
+                             std::to_string(folded) + " folded; transfer failed: " + why);
+        }
       }
     }
     if (chosen < 0) continue;
-    QuadComplex complex = std::move(candidates[chosen].first);
-    const CoarsenStats stats = candidates[chosen].second;
     result.resolution = resolution;
     result.shift = shift;
+    result.refined = refined - 1;
     result.folded_quads = folded;
     result.complex = std::move(complex);
     result.coarsen = stats;

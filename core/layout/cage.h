@@ -42,19 +42,22 @@ struct VoxelCageInfo {
 
 //! The boundary surface of the voxelization of a closed triangle mesh as a pure quad mesh,
 //! one quad per boundary face of the occupied cells, oriented outward, at the voxel
-//! positions. A cell is inside when its centre is inside for the ray parity along at least
-//! two of the three axes (rays slightly offset from the cell centres against exact hits).
+//! positions. A sample point is inside when it is inside for the ray parity along at least
+//! two of the three axes (rays slightly offset from the sample points against exact hits); a
+//! cell is occupied when at least half of its subsamples³ sample points (the centres of a
+//! subsamples × subsamples × subsamples split of the cell; 1: the cell centre) are inside.
 //! Empty cells enclosed by occupied ones are filled; then, until the surface is manifold at
 //! every grid vertex (the occupied and the empty cells of its 2×2×2 block are each
 //! face-connected in the block), the cell of a bad block whose centre lies closest to the
 //! mesh surface is flipped (preferring flips that repair the block; each cell flips at most
 //! once).
 //! \param resolution cells along the longest bounding-box axis (2..200; memory grows with its
-//! cube). \throw InvalidInputError for a mesh with boundary or without faces, a resolution out of
-//!        range, or a configuration that cannot be repaired.
+//! cube). \throw InvalidInputError for a mesh with boundary or without faces, a resolution or
+//!        subsamples out of range, or a configuration that cannot be repaired.
 //! \param shift offset of the grid along every axis, in cells (another sampling of the shape).
+//! \param subsamples sample points per cell and axis (1..8), see above.
 PolyMesh voxel_cage(const TriMesh& mesh, int resolution, VoxelCageInfo* info = nullptr,
-                    double shift = 0.0);
+                    double shift = 0.0, int subsamples = 1);
 
 struct CageFitOptions {
   //! Uniform Laplacian smoothing rounds of the voxel cage in 3D before the first projection
@@ -72,13 +75,32 @@ struct CageFitOptions {
 //! normal of the projected quad points against the mesh normal at its corners).
 int fit_cage(PolyMesh& cage, const TriMesh& mesh, const CageFitOptions& options = {});
 
+//! Splits every quad of a fitted cage into 4 (split_to_quads: edge midpoints and face
+//! centroids, original vertices kept with their indices) and moves the new vertices onto
+//! \p mesh (closest point on a face facing the same way as the split cage at the vertex).
+//! Straight cage edges cut across concave corners and narrow gaps between their end vertices;
+//! the split ones follow the surface, so the transfer's closest-point samples of an arc stay
+//! on the arc's own side. The base complex keeps its nodes (the new vertices are regular).
+//! \pre is_pure_quad(cage).
+void refine_fitted_cage(PolyMesh& cage, const TriMesh& mesh);
+
 struct CageOptions {
   //! Cells along the longest bounding-box axis for the first attempt.
   int resolution = 12;
-  //! Attempts in all: the grid at resolution, then shifted by half a cell, then resolution + 1,
-  //! shifted, ... until a cage has the mesh's genus and one component and its layout can be
-  //! transferred onto the mesh.
+  //! Attempts in all: the grid at resolution (shifted by `shift` cells), then shifted by half a
+  //! cell more, then resolution + 1, ... until a cage has the mesh's genus and one component
+  //! and its layout can be transferred onto the mesh.
   int attempts = 8;
+  //! Grid shift (cells) of the first attempt.
+  double shift = 0.0;
+  //! Sample points per cell and axis of the inside test (voxel_cage): 1 classifies a cell by
+  //! its centre; more classify it by its inside fraction (smoother on shapes whose thin parts
+  //! are about one cell thick).
+  int subsamples = 1;
+  //! When no complex of an attempt's fitted cage transfers, the cage is split up to this many
+  //! times (refine_fitted_cage, each 4 quads per quad) and the (coarsened, then full) complex
+  //! of each split cage is tried again. Ignored with all_edges.
+  int max_refine = 2;
   //! Use every cage edge as an arc (one patch per cage quad) instead of the cage's base
   //! complex (separatrices of its irregular vertices).
   bool all_edges = false;
@@ -93,13 +115,16 @@ struct CageOptions {
 };
 
 struct CageResult {
-  Layout layout;         //!< valid layout on the input mesh (validate_layout passed)
-  PolyMesh cage;         //!< the fitted cage (vertices on the mesh surface)
+  Layout layout;  //!< valid layout on the input mesh (validate_layout passed)
+  //! The fitted cage (vertices on the mesh surface) after `refined` splits; its first
+  //! voxels.grid_vertex.size() vertices are the voxel cage's.
+  PolyMesh cage;
   QuadComplex complex;   //!< the layout on the cage (after coarsening)
   CoarsenStats coarsen;  //!< before/after counts (equal without coarsening)
   VoxelCageInfo voxels;
   int resolution = 0;                 //!< resolution of the attempt that succeeded
   double shift = 0;                   //!< grid shift (cells) of the attempt that succeeded
+  int refined = 0;                    //!< refine_fitted_cage splits of the cage that succeeded
   int folded_quads = 0;               //!< after fit_cage
   std::vector<std::string> warnings;  //!< attempts that failed, folded quads
 };

@@ -8,6 +8,7 @@
 
 #include "core/layout/base_complex.h"
 #include "core/layout/layout.h"
+#include "core/layout/patch_import.h"
 #include "core/mesh/mesh.h"
 
 namespace qs {
@@ -32,6 +33,12 @@ struct QuadImportOptions {
   //! the triangulated quad mesh, like a transfer (without a target use refine >= 2 so the
   //! routes have room). Ignored with all_edges.
   double coarsen = 0;
+  //! With a target mesh: a patch partition of the target that the quad mesh was made from
+  //! (QuadWild writes its patches as <target>.patch and <target>.corners). When the transfer of
+  //! the base complex fails (its separatrices spiral into a grid the target is too coarse for),
+  //! the layout is made from this partition instead (layout_from_partition: every n-sided
+  //! patch split into quads), with a warning. Not owned; nullptr: no fallback.
+  const PatchPartition* target_partition = nullptr;
 };
 
 struct QuadImportResult {
@@ -42,6 +49,10 @@ struct QuadImportResult {
   bool split = false;    //!< non-quad faces were split (split_to_quads)
   CoarsenStats coarsen;  //!< counts before/after coarsening (after == before without it)
   std::vector<std::string> warnings;
+  //! True when the layout was made from options.target_partition (then \p complex is the base
+  //! complex that could not be transferred, and partition_stats describes the layout).
+  bool via_partition = false;
+  PatchLayoutStats partition_stats;
 };
 
 //! Triangulates a pure quad mesh, each quad first split refine × refine by bilinear
@@ -81,7 +92,8 @@ Layout transfer_complex(const PolyMesh& quads, const QuadComplex& complex, const
 //! Whole import: splits non-quad faces once (with a warning), computes the base complex (or
 //! all edges), coarsens it (options.coarsen > 0), then builds the layout on the triangulated
 //! quad mesh (\p target == nullptr; exact, or routed like a transfer when coarsened) or on
-//! \p target (transfer_complex).
+//! \p target (transfer_complex; when that fails and options.target_partition is given,
+//! layout_from_partition on it).
 //! \throw InvalidInputError as base_complex, triangulate_quads and transfer_complex.
 QuadImportResult import_quads(const PolyMesh& quads, const TriMesh* target,
                               const QuadImportOptions& options = {});
