@@ -40,7 +40,7 @@ Stats compare(const std::string& name, const qs::TriMesh& mesh, const qs::Layout
   for (const qs::LayoutNode& n : layout.nodes) vertices.push_back(n.vertex);
   const std::vector<qs::Vec3> est =
       qs::estimate_node_gradients(pipeline.mesh(), pipeline.geometry(), pipeline.field()->theta,
-                                  param.corner_uv, options.param, vertices);
+                                  param, options.param, vertices);
   const std::vector<qs::Vec3> exact = qs::exact_node_gradients(mesh, layout, options, vertices);
 
   Stats s;

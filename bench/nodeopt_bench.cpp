@@ -1,11 +1,16 @@
 // Node-optimization step cost (issue #5): per-step time of optimize_nodes against one
 // parameterization factorization + solve measured in the same process. Not a test.
 //
-//   qs_nodeopt_bench MESH LAYOUT [STEPS=10] [REPEATS=3]
+//   qs_nodeopt_bench MESH LAYOUT [STEPS=10] [REPEATS=3] [descent] [fresh] [steps]
 //
+// descent: no hop polish and no fold-over removal after the descent (only the STEPS descent
+// steps are timed in "optimize"); fresh: NodeOptOptions::reuse_field off (a fresh Pipeline per
+// trial with re-routed arcs, the behaviour before session 3); steps: print every step.
 // Times are CPU seconds of the process (CLOCK_PROCESS_CPUTIME_ID: wall time is meaningless
-// on a shared, overloaded machine); run with OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 so that
-// no spinning helper thread is counted. A step's time runs from one observer report to the
+// on a shared, overloaded machine); run with OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
+// OMP_THREAD_LIMIT=1 so that no spinning helper thread is counted (Debian's CHOLMOD asks for 4
+// OpenMP threads in its supernodal factorization whatever OMP_NUM_THREADS says; only the
+// thread limit caps them). A step's time runs from one observer report to the
 // next. Prints one line per repeat and a summary: the median over repeats of the fresh pipeline
 // (field + parameterization setup and solve), of one parameterization re-solve (assembly +
 // CHOLMOD numeric factorization + back-substitution on the same ParamSolver), of the
@@ -16,6 +21,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <string>
 #include <vector>
 
 #include "core/layout/layout_io.h"
@@ -35,9 +41,14 @@ double cpu_now() {
 struct StepTimer : qs::Observer {
   double last = 0;
   std::vector<double> descent;
+  bool verbose = false;
   void on_step(const qs::StepReport& r) override {
     const double now = cpu_now();
     if (r.phase == "descent") descent.push_back(now - last);
+    if (verbose)
+      std::printf("  step %d %s: E %.9g %s, fold-overs %d, moved %d, %.3f s CPU\n", r.step,
+                  r.phase.c_str(), r.E, r.accepted ? "accepted" : "rejected", r.foldovers,
+                  r.moved_nodes, now - last);
     last = now;
   }
 };
@@ -60,6 +71,15 @@ int main(int argc, char** argv) {
     const qs::Layout layout = qs::load_layout(argv[2], mesh);
     const int steps = argc > 3 ? std::atoi(argv[3]) : 10;
     const int repeats = argc > 4 ? std::atoi(argv[4]) : 3;
+    // Flags after REPEATS: "descent" (no hop polish, no fold-over removal at the end), "fresh"
+    // (NodeOptOptions::reuse_field off: a fresh Pipeline per trial with re-routed arcs).
+    // "steps": print every step.
+    bool descent_only = false, fresh_trials = false, verbose = false;
+    for (int k = 5; k < argc; ++k) {
+      descent_only |= std::string(argv[k]) == "descent";
+      fresh_trials |= std::string(argv[k]) == "fresh";
+      verbose |= std::string(argv[k]) == "steps";
+    }
     const qs::PipelineOptions options;
     std::vector<double> fresh, resolve, step, total, ratio;
     for (int rep = 0; rep < repeats; ++rep) {
@@ -76,8 +96,15 @@ int main(int argc, char** argv) {
 
       qs::NodeOptOptions no;
       no.max_steps = steps;
+      no.reuse_field = !fresh_trials;
+      if (descent_only) {
+        no.hop_polish = false;
+        no.orientation_at_end = false;
+        no.stiffen_at_end = false;
+      }
       qs::NodeOptStats stats;
       StepTimer timer;
+      timer.verbose = verbose;
       t0 = timer.last = cpu_now();
       const qs::NodeOptResult r =
           qs::optimize_nodes(mesh, layout, options, no, &timer, nullptr, &stats);
@@ -87,10 +114,10 @@ int main(int argc, char** argv) {
       std::printf(
           "repeat %d: fresh pipeline %.3f s, param re-solve %.3f s, median step %.3f s "
           "(%.1fx), optimize %.3f s, steps %d (accepted %d), E %.6g -> %.6g, fresh pipelines "
-          "%d, reused solves %d, gradient reuses %d\n",
+          "%d, relayouts %d, reused solves %d, gradient reuses %d\n",
           rep, fresh.back(), resolve.back(), step.back(), ratio.back(), total.back(), r.steps,
-          r.accepted, r.E_init, r.E_final, stats.fresh_pipelines, stats.reused_solves,
-          stats.gradient_reuses);
+          r.accepted, r.E_init, r.E_final, stats.fresh_pipelines, stats.relayouts,
+          stats.reused_solves, stats.gradient_reuses);
     }
     std::printf(
         "median: faces %zu, nodes %zu, fresh pipeline %.3f s, param re-solve %.3f s, median "

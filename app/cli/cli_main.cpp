@@ -66,6 +66,14 @@ int main(int argc, char** argv) {
   cmd_opt->add_flag("--no-orientation", opt.no_orientation,
                     "No orientation constraints against fold-overs after the node optimization "
                     "(stiffening only)");
+  auto* sizing_on = cmd_opt->add_flag_callback(
+      "--sizing", [&opt] { opt.sizing = true; },
+      "Scale the parameterization's targets by the curl-reducing sizing field (paper §5.3; "
+      "off by default)");
+  cmd_opt
+      ->add_flag_callback(
+          "--no-sizing", [&opt] { opt.sizing = false; }, "Unit targets, no sizing field (default)")
+      ->excludes(sizing_on);
   cmd_opt->add_option("--sharp-angle", opt.sharp_angle_deg, "Sharp feature dihedral angle (deg)")
       ->capture_default_str();
   cmd_opt->add_option("--threads", opt.threads, "Number of threads")->capture_default_str();

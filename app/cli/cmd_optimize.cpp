@@ -56,6 +56,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     PipelineOptions options;
     options.field.constraints.sharp_angle_deg = o.sharp_angle_deg;
     options.field.constraints.curvature = !o.no_align;
+    if (o.sizing) options.param.sizing.enabled = *o.sizing;
     if (o.integer && !(o.quad_size > 0 || o.quad_count > 0))
       throw InvalidInputError("--integer needs --quad-size Q or --quad-count N");
     // Node optimization first (it runs its own field + parameterization solves); the final
@@ -103,7 +104,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
         relaxed = std::make_shared<Pipeline>(mesh, layout, options);
       if (!relaxed->parameterization()) relaxed->compute_parameterization();
       E_relaxed = unweighted_energy(relaxed->mesh(), relaxed->geometry(), relaxed->field()->theta,
-                                    relaxed->parameterization()->corner_uv, options.param);
+                                    *relaxed->parameterization(), options.param);
       const double q = o.quad_size > 0 ? o.quad_size
                                        : quad_size_for_count(relaxed->topology(),
                                                              relaxed->extract(), o.quad_count);
@@ -146,8 +147,8 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     const Extraction& ex = pipeline.extract();
     const double extract_s = seconds_since(t0);
     const ParamMetrics m = pipeline.metrics();
-    const double E_final = unweighted_energy(pipeline.mesh(), pipeline.geometry(), field.theta,
-                                             param.corner_uv, options.param);
+    const double E_final =
+        unweighted_energy(pipeline.mesh(), pipeline.geometry(), field.theta, param, options.param);
     report["E_init"] = relaxed_result            ? relaxed_result->E_init
                        : integer && !node_result ? E_relaxed
                        : node_result             ? node_result->E_init
@@ -222,6 +223,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
                                   {"redundant", param.redundant},
                                   {"unknowns", param.unknowns},
                                   {"anisotropic", options.param.anisotropic},
+                                  {"sizing", options.param.sizing.enabled},
                                   {"aligned", !o.no_align}};
     const fs::path out(o.out);
     write_param_obj(pipeline.mesh(), param.corner_uv, (out / "param.obj").string());

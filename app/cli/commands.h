@@ -2,6 +2,7 @@
 // qs::QsError (mapped to exit codes by qs::exit_code_for).
 #pragma once
 
+#include <optional>
 #include <string>
 
 namespace qs::cli {
@@ -30,6 +31,8 @@ struct OptimizeOptions {
   bool no_align = false;
   bool discrete_relocation = false;
   bool no_orientation = false;  //!< no orientation constraints after the node optimization
+  //! Curl-reducing sizing field (ParamOptions::sizing); unset: the library default.
+  std::optional<bool> sizing;
   double sharp_angle_deg = 35.0;
   int threads = 2;
 };

@@ -73,21 +73,8 @@ CrossFieldSolver::CrossFieldSolver(const TriMesh& mesh, const GeometryCache& g,
   const double lambda = options.constraint_weight;
   for (int k = 0; k < nc; ++k)
     triplets.emplace_back(field_.constraints.face[k], field_.constraints.face[k], lambda);
-  if (!layout.arcs.empty()) {
-    // Gauge: pin a face next to the middle of the longest arc, along that arc (away from nodes).
-    int best_arc = 0;
-    for (size_t a = 0; a < layout.arcs.size(); ++a)
-      if (layout.arcs[a].path.size() > layout.arcs[best_arc].path.size())
-        best_arc = static_cast<int>(a);
-    const auto& path = layout.arcs[best_arc].path;
-    const size_t m = (path.size() - 1) / 2;
-    const auto h = mesh.find_halfedge(mesh.vertex_handle(path[m]), mesh.vertex_handle(path[m + 1]));
-    const auto fh = mesh.is_boundary(h) ? mesh.face_handle(mesh.opposite_halfedge_handle(h))
-                                        : mesh.face_handle(h);
-    arc_gauge_face_ = fh.idx();
-    arc_gauge_angle_ =
-        g.angle_in_face(arc_gauge_face_, mesh.point(mesh.vertex_handle(path[m + 1])) -
-                                             mesh.point(mesh.vertex_handle(path[m])));
+  choose_arc_gauge(mesh, g, layout);
+  if (arc_gauge_face_ >= 0) {
     if (nc == 0) {
       field_.gauge_face = arc_gauge_face_;
       gauge_angle_ = arc_gauge_angle_;
@@ -100,14 +87,40 @@ CrossFieldSolver::CrossFieldSolver(const TriMesh& mesh, const GeometryCache& g,
 
   // The only factorization needed when no cluster contradicts the layout.
   factorize(solver_, matrix_);
+  // Kept for update_layout, which starts again from every constraint (shared with solver_ until
+  // a drop pass factorizes: SpdSolver copies are copy-on-write).
+  full_matrix_ = matrix_;
+  full_ = solver_;
+  full_gauge_face_ = field_.gauge_face;
   warm_start(g, /*allow_factorization=*/true);
   solve(g);
   drop_conflicting_clusters(mesh, g);
+  residual_mismatches_ = count_mismatches(g);
   field_.active_constraints = nc - field_.dropped_constraints;
   field_.timings.setup_s = seconds_since(t_setup);
 }
 
 CrossFieldSolver::~CrossFieldSolver() = default;
+
+void CrossFieldSolver::choose_arc_gauge(const TriMesh& mesh, const GeometryCache& g,
+                                        const Layout& layout) {
+  arc_gauge_face_ = -1;
+  arc_gauge_angle_ = 0;
+  if (layout.arcs.empty()) return;
+  // A face next to the middle of the longest arc, along that arc (away from nodes).
+  int best_arc = 0;
+  for (size_t a = 0; a < layout.arcs.size(); ++a)
+    if (layout.arcs[a].path.size() > layout.arcs[best_arc].path.size())
+      best_arc = static_cast<int>(a);
+  const auto& path = layout.arcs[best_arc].path;
+  const size_t m = (path.size() - 1) / 2;
+  const auto h = mesh.find_halfedge(mesh.vertex_handle(path[m]), mesh.vertex_handle(path[m + 1]));
+  const auto fh = mesh.is_boundary(h) ? mesh.face_handle(mesh.opposite_halfedge_handle(h))
+                                      : mesh.face_handle(h);
+  arc_gauge_face_ = fh.idx();
+  arc_gauge_angle_ = g.angle_in_face(arc_gauge_face_, mesh.point(mesh.vertex_handle(path[m + 1])) -
+                                                          mesh.point(mesh.vertex_handle(path[m])));
+}
 
 void CrossFieldSolver::factorize(SpdSolver& solver, const Eigen::SparseMatrix<double>& A) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -201,8 +214,22 @@ void CrossFieldSolver::warm_start(const GeometryCache& g, bool allow_factorizati
   if (mode == ClusterWarmStart::LayoutField && arc_gauge_face_ < 0)
     mode = ClusterWarmStart::LargestCluster;  // no arc to pin the reference field along
   if (mode == ClusterWarmStart::LayoutField) {
-    if (!allow_factorization) return;  // keep the offsets (update_layout)
-    Eigen::SparseMatrix<double> L0 = matrix_;
+    // The reference field's matrix L0 (no direction constraints, one face pinned) is
+    // factorized once and kept in reference_: the edge terms of the right-hand side sum to
+    // zero, so the soft pin holds exactly and pinning another face only rotates the whole
+    // field. update_layout solves it for the new period jumps and rotates the result onto the
+    // new layout's arc gauge.
+    if (!reference_.factorized()) {
+      if (!allow_factorization) return;  // keep the offsets
+      Eigen::SparseMatrix<double> L0 = matrix_;
+      for (int k = 0; k < nc; ++k)
+        if (active(k))
+          L0.coeffRef(field_.constraints.face[k], field_.constraints.face[k]) -= lambda;
+      if (field_.gauge_face >= 0) L0.coeffRef(field_.gauge_face, field_.gauge_face) -= lambda;
+      L0.coeffRef(arc_gauge_face_, arc_gauge_face_) += lambda;
+      factorize(reference_, L0);
+      reference_face_ = arc_gauge_face_;
+    }
     Eigen::VectorXd b = Eigen::VectorXd::Zero(g.n_faces);
     for (int e = 0; e < g.n_edges; ++e) {
       if (g.edge_face_i[e] < 0 || g.edge_face_j[e] < 0) continue;
@@ -210,15 +237,13 @@ void CrossFieldSolver::warm_start(const GeometryCache& g, bool allow_factorizati
       b(g.edge_face_i[e]) -= k;
       b(g.edge_face_j[e]) += k;
     }
-    for (int k = 0; k < nc; ++k)
-      if (active(k)) L0.coeffRef(field_.constraints.face[k], field_.constraints.face[k]) -= lambda;
-    if (field_.gauge_face >= 0) L0.coeffRef(field_.gauge_face, field_.gauge_face) -= lambda;
-    L0.coeffRef(arc_gauge_face_, arc_gauge_face_) += lambda;
-    b(arc_gauge_face_) += lambda * arc_gauge_angle_;
-    factorize(spare_, L0);
+    const bool same_face = reference_face_ == arc_gauge_face_;
+    b(reference_face_) += lambda * (same_face ? arc_gauge_angle_ : 0.0);
     ++field_.timings.solves;
+    Eigen::VectorXd reference = reference_.solve(b);
+    if (!same_face) reference.array() += arc_gauge_angle_ - reference(arc_gauge_face_);
     std::fill(cluster_offset_.begin(), cluster_offset_.end(), 0);
-    round_clusters(c, spare_.solve(b));
+    round_clusters(c, reference);
     field_.timings.warm_start_s +=
         seconds_since(t0) - (field_.timings.factorize_s - factorize_before);
     return;
@@ -270,7 +295,18 @@ void CrossFieldSolver::warm_start(const GeometryCache& g, bool allow_factorizati
       seconds_since(t0) - (field_.timings.factorize_s - factorize_before);
 }
 
-void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const GeometryCache& g) {
+int CrossFieldSolver::count_mismatches(const GeometryCache& g) const {
+  int bad = 0;
+  for (int e = 0; e < g.n_edges; ++e) {
+    if (!interior(g, e)) continue;
+    const double d = field_.theta[g.edge_face_j[e]] - field_.theta[g.edge_face_i[e]] - g.kappa[e];
+    bad += std::lround(d / kQuarter) != field_.period_jump[e];
+  }
+  return bad;
+}
+
+void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const GeometryCache& g,
+                                                 int tolerated) {
   const int nf = g.n_faces;
   const int nc = static_cast<int>(field_.constraints.face.size());
   if (nc == 0 || options_.max_conflict_passes <= 0) return;
@@ -278,19 +314,10 @@ void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const Geom
   const double factorize_before = field_.timings.factorize_s;
   const double lambda = options_.constraint_weight;
   int rings = options_.conflict_rings;
-  auto count_mismatches = [&] {
-    int bad = 0;
-    for (int e = 0; e < g.n_edges; ++e) {
-      if (!interior(g, e)) continue;
-      const double d = field_.theta[g.edge_face_j[e]] - field_.theta[g.edge_face_i[e]] - g.kappa[e];
-      bad += std::lround(d / kQuarter) != field_.period_jump[e];
-    }
-    return bad;
-  };
-  int mismatches = count_mismatches();
+  int mismatches = count_mismatches(g);
   std::vector<int> dist(nf), queue;
   std::vector<char> in_drop(field_.clusters, 0);
-  for (int pass = 0; pass < options_.max_conflict_passes && mismatches > 0; ++pass) {
+  for (int pass = 0; pass < options_.max_conflict_passes && mismatches > tolerated; ++pass) {
     // Clusters within `rings` face rings of an edge the field steps over by more than 45°.
     const std::vector<int> matching = principal_matching(g, field_.theta);
     std::fill(dist.begin(), dist.end(), -1);
@@ -357,7 +384,7 @@ void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const Geom
     std::swap(solver_, spare_);
     solve(g);
     ++field_.timings.conflict_passes;
-    const int now = count_mismatches();
+    const int now = count_mismatches(g);
     if (now >= mismatches) {
       // Dropping did not help: these steps are not caused by constraints (e.g. the smoothest
       // field itself turns by more than 45° across an edge). Restore the constraints, go back
@@ -473,8 +500,29 @@ const CrossField& CrossFieldSolver::update_layout(const TriMesh& mesh, const Geo
   propagate_clusters(mesh, g);
   if (cluster_of_ != old_cluster)
     throw QsError("internal error: constraint clusters changed in update_layout");
+  choose_arc_gauge(mesh, g, layout);
+  // Every constraint in force again, as in the constructor (the construction's factorization):
+  // clusters dropped for the previous layout may agree with this one.
+  const int nc = static_cast<int>(field_.constraints.face.size());
+  if (nc > 0 && field_.dropped_constraints > 0) {
+    matrix_ = full_matrix_;
+    solver_ = full_;
+    cluster_active_.assign(field_.clusters, 1);
+    constraint_active_.assign(nc, 1);
+    field_.dropped_constraints = 0;
+    field_.dropped_clusters = 0;
+    field_.gauge_face = full_gauge_face_;
+  }
   warm_start(g, /*allow_factorization=*/false);
-  return solve(g);
+  solve(g);
+  // Clusters that contradict the new layout (steps across edges that disagree with the new
+  // period jumps) are dropped as in the constructor; this factorizes only when there are any.
+  // As many mismatches as the constructor's passes left (the smoothest field itself turns by
+  // more than 45° there) are tolerated: a pass would not remove them.
+  drop_conflicting_clusters(mesh, g, residual_mismatches_);
+  field_.active_constraints =
+      static_cast<int>(field_.constraints.face.size()) - field_.dropped_constraints;
+  return field_;
 }
 
 void CrossFieldSolver::rotate(double phi) {

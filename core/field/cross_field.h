@@ -95,6 +95,12 @@ class CrossFieldSolver {
   CrossFieldSolver(const TriMesh& mesh, const GeometryCache& geometry, const Layout& layout,
                    const LayoutTopology& topology, const CrossFieldOptions& options = {});
   ~CrossFieldSolver();
+  //! A copy shares the factorizations (SpdSolver copies share them until one side factorizes):
+  //! copying is O(#F), and a copy re-solved by update_layout or solve does no CHOLMOD analysis
+  //! or factorization. The node optimizer gives each trial layout a copy of the current
+  //! solver. Not for use from two threads at the same time.
+  CrossFieldSolver(const CrossFieldSolver&) = default;
+  CrossFieldSolver& operator=(const CrossFieldSolver&) = default;
 
   //! Solves for θ with the current geometry (reuses the factorization). \p geometry must be the
   //! construction's cache continued by update_geometry (same connectivity, κ continued), so that
@@ -102,9 +108,12 @@ class CrossFieldSolver {
   //! projected onto the current faces.
   const CrossField& solve(const GeometryCache& geometry);
   //! After the layout changed on the same mesh connectivity (nodes moved to other vertices,
-  //! arcs rerouted): recomputes the period jumps and the clusters' relative rotations, redoes
-  //! the warm start (relaxed mode) and re-solves, reusing the factorization. The constraint set
-  //! (and clusters dropped as contradictory, and the gauge face) are kept from construction.
+  //! arcs rerouted): recomputes the period jumps and the clusters' relative rotations, puts
+  //! every constraint back in force (the construction's factorization), redoes the warm start
+  //! (relaxed mode; layout-field mode with its kept reference factorization) and re-solves.
+  //! Clusters that contradict the new layout are dropped as in the constructor (a
+  //! factorization per drop pass, only when more edges mismatch than the constructor's passes
+  //! left). The constraint set (from the construction's geometry) is kept.
   //! \throw TopologyError as the constructor, InvalidInputError when the mesh size changed.
   const CrossField& update_layout(const TriMesh& mesh, const GeometryCache& geometry,
                                   const Layout& layout, const LayoutTopology& topology);
@@ -126,7 +135,14 @@ class CrossFieldSolver {
   //! Without \p allow_factorization only the relaxed warm start runs (else offsets are kept).
   void warm_start(const GeometryCache& geometry, bool allow_factorization);
   void round_clusters(const std::vector<double>& c, const Eigen::VectorXd& theta);
-  void drop_conflicting_clusters(const TriMesh& mesh, const GeometryCache& geometry);
+  //! arc_gauge_face_ and arc_gauge_angle_ for \p layout (-1 / 0 without arcs).
+  void choose_arc_gauge(const TriMesh& mesh, const GeometryCache& geometry, const Layout& layout);
+  //! Drop passes while more than \p tolerated edges mismatch (update_layout tolerates the
+  //! ones the passes could not remove before).
+  void drop_conflicting_clusters(const TriMesh& mesh, const GeometryCache& geometry,
+                                 int tolerated = 0);
+  //! Interior edges whose principal matching differs from the period jump.
+  int count_mismatches(const GeometryCache& geometry) const;
 
   CrossFieldOptions options_;
   CrossField field_;
@@ -148,6 +164,16 @@ class CrossFieldSolver {
   //! Second factorization of the same pattern (trial drops, largest-cluster warm start), so a
   //! rejected trial never needs a re-factorization; symbolic analysis reused between trials.
   SpdSolver spare_{"cross field"};
+  //! Layout-field warm start: factorization of the matrix without direction constraints,
+  //! pinned at reference_face_ (kept for update_layout).
+  SpdSolver reference_{"cross field"};
+  int reference_face_ = -1;
+  int residual_mismatches_ = 0;  //!< mismatching edges left by the constructor's drop passes
+  //! The constructor's matrix and factorization with every constraint in force (before drop
+  //! passes), and its gauge face: update_layout starts from them.
+  Eigen::SparseMatrix<double> full_matrix_;
+  SpdSolver full_{"cross field"};
+  int full_gauge_face_ = -1;
 };
 
 //! Convenience: geometry + topology + one solve.

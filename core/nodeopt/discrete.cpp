@@ -102,7 +102,7 @@ NodeOptResult relocate_nodes_discrete(const TriMesh& mesh, const Layout& layout,
       Pipeline p(m, l, options);
       p.compute_field();
       const Parameterization& r = p.compute_parameterization();
-      E = unweighted_energy(p.mesh(), p.geometry(), p.field()->theta, r.corner_uv, options.param);
+      E = unweighted_energy(p.mesh(), p.geometry(), p.field()->theta, r, options.param);
       folds = r.foldovers;
       return true;
     } catch (const Cancelled&) {
@@ -118,7 +118,7 @@ NodeOptResult relocate_nodes_discrete(const TriMesh& mesh, const Layout& layout,
     Pipeline p(mesh, layout, options);
     p.compute_field();
     const Parameterization& r = p.compute_parameterization();
-    E = unweighted_energy(p.mesh(), p.geometry(), p.field()->theta, r.corner_uv, options.param);
+    E = unweighted_energy(p.mesh(), p.geometry(), p.field()->theta, r, options.param);
     foldovers = r.foldovers;
   }
   result.E_init = E;

@@ -2,6 +2,9 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <string>
+
+#include "core/base/errors.h"
 
 namespace qs {
 
@@ -11,7 +14,7 @@ namespace {
 // face plane. The face's 2D frame is (r_f, n_f × r_f), as in the parameterization.
 Vec3 face_corner_gradient(const TriMesh& mesh, const GeometryCache& g, double theta,
                           const std::vector<std::array<double, 2>>& uv, double aniso, double weight,
-                          int f, int k) {
+                          double target_scale, int f, int k) {
   const auto corners = face_corners_2d(mesh, g, f);
   Eigen::Vector2d p[3];
   for (int c = 0; c < 3; ++c) p[c] = Eigen::Vector2d(corners[c][0], corners[c][1]);
@@ -24,7 +27,9 @@ Vec3 face_corner_gradient(const TriMesh& mesh, const GeometryCache& g, double th
     for (int i = 0; i < 3; ++i) sum += c[i] * (p[(i + 2) % 3] - p[(i + 1) % 3]);
     return Eigen::Vector2d(J(sum) / a2);
   };
+  // Targets e^{s_t} u_t, e^{s_t} v_t (sizing, s_t frozen); the norms W use the unit directions.
   const Eigen::Vector2d u(std::cos(theta), std::sin(theta)), v(-u.y(), u.x());
+  const Eigen::Vector2d su = target_scale * u, sv = target_scale * v;
   const Eigen::Matrix2d Wu = u * u.transpose() + aniso * v * v.transpose();
   const Eigen::Matrix2d Wv = v * v.transpose() + aniso * u * u.transpose();
   const Eigen::Vector2d Je0 = J(p[k2] - p[k1]);
@@ -34,7 +39,7 @@ Vec3 face_corner_gradient(const TriMesh& mesh, const GeometryCache& g, double th
   for (int c = 0; c < 2; ++c) {
     const double val[3] = {uv[3 * f][c], uv[3 * f + 1][c], uv[3 * f + 2][c]};
     const Eigen::Vector2d gr = grad(val);
-    const Eigen::Vector2d& target = c == 0 ? u : v;
+    const Eigen::Vector2d& target = c == 0 ? su : sv;
     const Eigen::Matrix2d& W = c == 0 ? Wu : Wv;
     const Eigen::Vector2d res = gr - target;
     const Eigen::Vector2d Wr = W * res;
@@ -64,14 +69,19 @@ void tangent_basis(const Vec3& n, Vec3& t1, Vec3& t2) {
 Vec3 estimate_vertex_gradient(const TriMesh& mesh, const GeometryCache& g,
                               const std::vector<double>& theta,
                               const std::vector<std::array<double, 2>>& uv,
-                              const ParamOptions& options, int vertex) {
+                              const ParamOptions& options, int vertex,
+                              const std::vector<double>& log_scale) {
+  if (!log_scale.empty() && static_cast<int>(log_scale.size()) != g.n_faces)
+    throw InvalidInputError("node gradient: " + std::to_string(log_scale.size()) +
+                            " sizing log-scales for " + std::to_string(g.n_faces) + " faces");
   const double aniso = options.anisotropic ? options.anisotropy : 1.0;
   Vec3 sum(0, 0, 0);
   for (auto fh : mesh.vf_range(mesh.vertex_handle(vertex))) {
     const int f = fh.idx();
     const int k = corner_of(g, f, vertex);
     const double w = options.face_weights.empty() ? 1.0 : options.face_weights[f];
-    sum += face_corner_gradient(mesh, g, theta[f], uv, aniso, w, f, k);
+    const double scale = log_scale.empty() ? 1.0 : std::exp(log_scale[f]);
+    sum += face_corner_gradient(mesh, g, theta[f], uv, aniso, w, scale, f, k);
   }
   const Vec3 n = vertex_normal(mesh, g, vertex);
   return sum - (sum | n) * n;
@@ -81,11 +91,22 @@ std::vector<Vec3> estimate_node_gradients(const TriMesh& mesh, const GeometryCac
                                           const std::vector<double>& theta,
                                           const std::vector<std::array<double, 2>>& uv,
                                           const ParamOptions& options,
-                                          const std::vector<int>& vertices) {
+                                          const std::vector<int>& vertices,
+                                          const std::vector<double>& log_scale) {
   std::vector<Vec3> out;
   out.reserve(vertices.size());
-  for (int v : vertices) out.push_back(estimate_vertex_gradient(mesh, g, theta, uv, options, v));
+  for (int v : vertices)
+    out.push_back(estimate_vertex_gradient(mesh, g, theta, uv, options, v, log_scale));
   return out;
+}
+
+std::vector<Vec3> estimate_node_gradients(const TriMesh& mesh, const GeometryCache& g,
+                                          const std::vector<double>& theta,
+                                          const Parameterization& param,
+                                          const ParamOptions& options,
+                                          const std::vector<int>& vertices) {
+  return estimate_node_gradients(mesh, g, theta, param.corner_uv, options, vertices,
+                                 param.sizing_log_scale);
 }
 
 std::vector<double> freeze_field_after_move(const TriMesh& mesh, const GeometryCache& before,
@@ -105,13 +126,19 @@ std::vector<double> freeze_field_after_move(const TriMesh& mesh, const GeometryC
 
 double unweighted_energy(const TriMesh& mesh, const GeometryCache& g,
                          const std::vector<double>& theta,
-                         const std::vector<std::array<double, 2>>& uv,
-                         const ParamOptions& options) {
+                         const std::vector<std::array<double, 2>>& uv, const ParamOptions& options,
+                         const std::vector<double>& log_scale) {
   ParamOptions plain = options;
   plain.face_weights.clear();
   double e = 0;
-  for (double x : face_energies(mesh, g, theta, uv, plain)) e += x;
+  for (double x : face_energies(mesh, g, theta, uv, plain, log_scale)) e += x;
   return e;
+}
+
+double unweighted_energy(const TriMesh& mesh, const GeometryCache& g,
+                         const std::vector<double>& theta, const Parameterization& param,
+                         const ParamOptions& options) {
+  return unweighted_energy(mesh, g, theta, param.corner_uv, options, param.sizing_log_scale);
 }
 
 std::vector<Vec3> exact_node_gradients(const TriMesh& mesh, const Layout& layout,
@@ -127,7 +154,7 @@ std::vector<Vec3> exact_node_gradients(const TriMesh& mesh, const Layout& layout
     Pipeline p(std::move(moved), layout, options);
     p.compute_field();
     const Parameterization& r = p.compute_parameterization();
-    return unweighted_energy(p.mesh(), p.geometry(), p.field()->theta, r.corner_uv, options.param);
+    return unweighted_energy(p.mesh(), p.geometry(), p.field()->theta, r, options.param);
   };
   std::vector<Vec3> out;
   out.reserve(vertices.size());

@@ -25,17 +25,29 @@ void tangent_basis(const Vec3& n, Vec3& t1, Vec3& t2);
 //! fixed (algorithm.md §6.1): the 1-ring sum of per-face analytic gradients (anisotropic norm
 //! and ParamOptions::face_weights included), each with the field frozen relative to the edge
 //! opposite the vertex, projected onto the tangent plane of the area-weighted vertex normal.
+//! With sizing the targets are e^{s_t} u_t, e^{s_t} v_t, s_t held fixed per face like the field
+//! (\p log_scale: Parameterization::sizing_log_scale, size #F, or empty for s = 0).
 //! The descent direction d̃ is the negative of the result. Units: length (E ~ length²).
 //! \pre theta (size #F) and corner_uv (size 3·#F) belong to the current mesh state.
+//! \throw InvalidInputError when log_scale is neither empty nor of size #F.
 Vec3 estimate_vertex_gradient(const TriMesh& mesh, const GeometryCache& geometry,
                               const std::vector<double>& theta,
                               const std::vector<std::array<double, 2>>& corner_uv,
-                              const ParamOptions& options, int vertex);
+                              const ParamOptions& options, int vertex,
+                              const std::vector<double>& log_scale = {});
 
 //! estimate_vertex_gradient for each vertex in \p vertices.
 std::vector<Vec3> estimate_node_gradients(const TriMesh& mesh, const GeometryCache& geometry,
                                           const std::vector<double>& theta,
                                           const std::vector<std::array<double, 2>>& corner_uv,
+                                          const ParamOptions& options,
+                                          const std::vector<int>& vertices,
+                                          const std::vector<double>& log_scale = {});
+
+//! The same for a solved parameterization: its corner values and its sizing log-scale.
+std::vector<Vec3> estimate_node_gradients(const TriMesh& mesh, const GeometryCache& geometry,
+                                          const std::vector<double>& theta,
+                                          const Parameterization& param,
                                           const ParamOptions& options,
                                           const std::vector<int>& vertices);
 
@@ -62,10 +74,17 @@ std::vector<Vec3> exact_node_gradients(const TriMesh& mesh, const Layout& layout
                                        const ExactGradientOptions& fd = {},
                                        const Observer* observer = nullptr);
 
-//! Residual E of energy (1) without face weights: Σ face_energies (length² units).
+//! Residual E of energy (1) without face weights: Σ face_energies (length² units), with the
+//! targets scaled by e^{s_t} (\p log_scale, size #F, or empty for s = 0).
 double unweighted_energy(const TriMesh& mesh, const GeometryCache& geometry,
                          const std::vector<double>& theta,
                          const std::vector<std::array<double, 2>>& corner_uv,
+                         const ParamOptions& options, const std::vector<double>& log_scale = {});
+
+//! The same for a solved parameterization: its corner values and its sizing log-scale (the
+//! energy the solve minimized, without face weights). Use this form whenever sizing may be on.
+double unweighted_energy(const TriMesh& mesh, const GeometryCache& geometry,
+                         const std::vector<double>& theta, const Parameterization& param,
                          const ParamOptions& options);
 
 }  // namespace qs

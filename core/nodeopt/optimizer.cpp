@@ -25,7 +25,7 @@ void solve_and_measure(Evaluation& ev, const PipelineOptions& options) {
   ev.pipeline->compute_field();
   const Parameterization& r = ev.pipeline->compute_parameterization();
   ev.E = unweighted_energy(ev.pipeline->mesh(), ev.pipeline->geometry(),
-                           ev.pipeline->field()->theta, r.corner_uv, options.param);
+                           ev.pipeline->field()->theta, r, options.param);
   ev.foldovers = r.foldovers;
 }
 
@@ -33,6 +33,16 @@ Evaluation evaluate_fresh(const TriMesh& mesh, const Layout& layout, const Pipel
                           bool validate) {
   Evaluation ev;
   ev.pipeline = std::make_shared<Pipeline>(mesh, layout, options, validate);
+  solve_and_measure(ev, options);
+  return ev;
+}
+
+// Nodes moved to other vertices (re-routed layout): a Pipeline that reuses \p previous's field
+// solver (update_layout, no factorization) and geometry; see Pipeline(mesh, layout, previous).
+Evaluation evaluate_relayout(const Pipeline& previous, const TriMesh& mesh, const Layout& layout,
+                             const PipelineOptions& options) {
+  Evaluation ev;
+  ev.pipeline = std::make_shared<Pipeline>(mesh, layout, previous);
   solve_and_measure(ev, options);
   return ev;
 }
@@ -122,7 +132,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     current.pipeline = std::move(start);
     current.E = unweighted_energy(current.pipeline->mesh(), current.pipeline->geometry(),
                                   current.pipeline->field()->theta,
-                                  current.pipeline->parameterization()->corner_uv, options.param);
+                                  *current.pipeline->parameterization(), options.param);
     current.foldovers = current.pipeline->parameterization()->foldovers;
     counters.warm_start = true;
   } else {
@@ -132,6 +142,16 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
   // False when current.pipeline was re-solved for a rejected trial (it then holds the trial's
   // positions, not state's).
   bool current_solved = true;
+  // A state whose nodes moved to other vertices (re-routed arcs): a Pipeline continued from the
+  // current one (NodeOptOptions::reuse_field), or a fresh one.
+  auto evaluate_switched = [&](const TriMesh& m, const Layout& l) {
+    if (no.reuse_field && current.pipeline->field()) {
+      ++counters.relayouts;
+      return evaluate_relayout(*current.pipeline, m, l, options);
+    }
+    ++counters.fresh_pipelines;
+    return evaluate_fresh(m, l, options, false);
+  };
   // Re-routing keeps the patch count: computed once.
   const RerouteContext reroute = make_reroute_context(mesh, layout);
   result.E_init = current.E;
@@ -189,8 +209,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     sweep.relocation = no.relocation;
     const HopEvaluator evaluate = [&](const TriMesh& m, const Layout& l, double& E, int& folds) {
       try {
-        const Evaluation ev = evaluate_fresh(m, l, options, false);
-        ++counters.fresh_pipelines;
+        const Evaluation ev = evaluate_switched(m, l);
         E = ev.E;
         folds = ev.foldovers;
         return true;
@@ -210,8 +229,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
         if (hopped.layout.nodes[n].vertex != state.layout.nodes[n].vertex)
           hopped.anchor[n] = vertex_surface_point(original, hopped.layout.nodes[n].vertex);
       check_cancel(observer);
-      Evaluation next = evaluate_fresh(hopped.mesh, hopped.layout, options, false);
-      ++counters.fresh_pipelines;
+      Evaluation next = evaluate_switched(hopped.mesh, hopped.layout);
       if (next.E <= current.E) {  // equal to h.E: the same deterministic solve
         if (!pre_polish) pre_polish = std::make_unique<State>(state);
         state = std::move(hopped);
@@ -262,7 +280,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
       } else {
         const Pipeline& p = *current.pipeline;
         grad = estimate_node_gradients(p.mesh(), p.geometry(), p.field()->theta,
-                                       p.parameterization()->corner_uv, options.param, vertices);
+                                       *p.parameterization(), options.param, vertices);
         scale = no.estimator_scale;
       }
       // Node-Voronoi cells on the original mesh, from all node vertices.
@@ -281,6 +299,8 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
       trial = state;
       switched.assign(movable.size(), 0);
       int moved = 0;
+      // Arc and node obstacles of the trial layout, kept up to date by each re-routing.
+      LayoutObstacles obstacles = make_layout_obstacles(trial.mesh, trial.layout);
       for (size_t i = 0; i < movable.size(); ++i) {
         const int n = movable[i];
         const double len = alpha * scale * grad[i].norm();
@@ -294,13 +314,15 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
         const GeodesicTrace tr = trace_straightest_geodesic(
             original, trial.anchor[n], -grad[i] / grad[i].norm(), len, blocked);
         const int v = trial.layout.nodes[n].vertex;
-        std::vector<char> forbidden = forbidden_relocation_vertices(trial.mesh, trial.layout, n);
-        if (no_switch[i]) forbidden.assign(forbidden.size(), 1);
+        const std::vector<char> forbidden =
+            no_switch[i] ? std::vector<char>(trial.mesh.n_vertices(), 1)
+                         : forbidden_relocation_vertices(trial.layout, n, obstacles);
         const int w = choose_relocation_vertex(trial.mesh, original, tr.end, tr.end_position, v,
                                                forbidden, no.relocation);
         if (w < 0) continue;
         if (w != v) {
-          if (!move_node_and_reroute(trial.mesh, trial.layout, n, w, no.relocation, &reroute))
+          if (!move_node_and_reroute(trial.mesh, trial.layout, n, w, no.relocation, &reroute,
+                                     &obstacles))
             continue;
           trial.mesh.set_point(trial.mesh.vertex_handle(v),
                                original.point(original.vertex_handle(v)));
@@ -323,8 +345,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
           next = evaluate_reused(current.pipeline, trial.mesh, options);
           ++counters.reused_solves;
         } else {
-          next = evaluate_fresh(trial.mesh, trial.layout, options, false);
-          ++counters.fresh_pipelines;
+          next = evaluate_switched(trial.mesh, trial.layout);
         }
         return true;
       } catch (const Cancelled&) {
@@ -421,8 +442,8 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
         if (par.orientation.success && par.foldovers < ev.foldovers) {
           out.orientation_constraints = true;
           out.orientation_options = oriented.param.orientation;
-          out.E_final = unweighted_energy(p->mesh(), p->geometry(), p->field()->theta,
-                                          par.corner_uv, options.param);
+          out.E_final =
+              unweighted_energy(p->mesh(), p->geometry(), p->field()->theta, par, options.param);
           out.foldovers_final = par.foldovers;
           out.pipeline = std::move(p);
         }

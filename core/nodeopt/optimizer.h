@@ -39,6 +39,17 @@ struct NodeOptOptions {
   //! When a step raises E and some nodes changed their vertex in it, retry the step once with
   //! those nodes kept on their vertices before halving α (the switch itself can raise E).
   bool retry_without_switches = true;
+  //! A trial in which nodes change their vertex (re-routed arcs), and a hop evaluation,
+  //! continues the current Pipeline (Pipeline(mesh, layout, previous)): a copy of its field
+  //! solver re-solved for the new layout with the same constraint set and factorizations.
+  //! false: a fresh Pipeline per such trial (curvature, constraints and every factorization
+  //! redone; slower; its field differs slightly where relocated vertices changed the
+  //! curvature, since a continued field keeps the start geometry's constraints).
+  //! Off by default: on spot (imported onto itself) the continued field lets the descent go
+  //! further (E 1.27 instead of 1.45) into a state with a flipped cone at one node, where the
+  //! orientation constraints are infeasible and 12 fold-overs remain; the fresh path ends with
+  //! none. On the 70K bunny it makes a step about 30 % cheaper (docs/benchmarks.md).
+  bool reuse_field = false;
   //! Polish by discrete hops (discrete.h hop_sweep) when the descent ends (no node moves, more
   //! than max_halvings halvings, or the step budget is used up): the descent can stop in a local
   //! optimum of E for the node carried by its current (relocated) vertex, which a hop to a
@@ -106,7 +117,8 @@ struct NodeOptResult {
 
 //! Counters of the work done by optimize_nodes (for benchmarks and the reuse test).
 struct NodeOptStats {
-  int fresh_pipelines = 0;  //!< Pipelines built (a node changed its vertex, or the start)
+  int fresh_pipelines = 0;  //!< Pipelines built from scratch (the start, reuse_field off)
+  int relayouts = 0;        //!< Pipelines continued from the current one (a node switched)
   int reused_solves = 0;    //!< re-solves of the previous Pipeline after vertices moved
   int gradient_reuses = 0;  //!< steps after a rejection that reused the gradient
   bool warm_start = false;  //!< the given start Pipeline served as the initial solve
@@ -121,7 +133,8 @@ std::vector<int> movable_nodes(const TriMesh& mesh, const Layout& layout);
 //! position back). Every step is reported to \p observer, which is polled between solves.
 //! Steps in which no node changes its vertex re-solve the previous Pipeline in place (geometry
 //! updated, solver setup and factorization patterns kept); a step that re-routes arcs builds a
-//! new one (without re-validating: re-routing keeps the layout's structure).
+//! new one (without re-validating: re-routing keeps the layout's structure), continued from the
+//! current one (NodeOptOptions::reuse_field).
 //! \p start, when given, is a Pipeline already solved (compute_parameterization) at exactly
 //! (\p mesh, \p layout) with \p options: it serves as the initial solve. \p stats, when given,
 //! receives work counters.

@@ -103,6 +103,38 @@ std::vector<char> forbidden_relocation_vertices(const TriMesh& mesh, const Layou
   return out;
 }
 
+LayoutObstacles make_layout_obstacles(const TriMesh& mesh, const Layout& layout) {
+  LayoutObstacles out;
+  out.routing = obstacles_of_layout(mesh, layout);
+  out.fixed.assign(mesh.n_vertices(), 0);
+  for (auto vh : mesh.vertices())
+    if (mesh.is_boundary(vh)) out.fixed[vh.idx()] = 1;
+  for (const auto& [a, b] : layout.feature_edges) {
+    if (a >= 0 && a < static_cast<int>(out.fixed.size())) out.fixed[a] = 1;
+    if (b >= 0 && b < static_cast<int>(out.fixed.size())) out.fixed[b] = 1;
+  }
+  return out;
+}
+
+std::vector<char> forbidden_relocation_vertices(const Layout& layout, int node_index,
+                                                const LayoutObstacles& obstacles) {
+  // Every arc and node vertex, except the node's own arcs (their vertices shared with other
+  // arcs are node vertices, re-marked below) and its own vertex.
+  std::vector<char> out = obstacles.fixed;
+  const std::vector<char>& blocked = obstacles.routing.vertex_blocked;
+  for (size_t v = 0; v < out.size(); ++v) out[v] |= blocked[v];
+  const int id = layout.nodes[node_index].id;
+  for (const auto& arc : layout.arcs) {
+    if (arc.from != id && arc.to != id) continue;
+    for (int v : arc.path) out[v] = obstacles.fixed[v];
+  }
+  const int own = layout.nodes[node_index].vertex;
+  out[own] = obstacles.fixed[own];
+  for (size_t n = 0; n < layout.nodes.size(); ++n)
+    if (static_cast<int>(n) != node_index) out[layout.nodes[n].vertex] = 1;
+  return out;
+}
+
 bool same_layout_structure(const LayoutTopology& a, const LayoutTopology& b) {
   if (a.patches.size() != b.patches.size() || a.num_nodes != b.num_nodes) return false;
   for (int n = 0; n < a.num_nodes; ++n)
@@ -222,7 +254,8 @@ RerouteContext make_reroute_context(const TriMesh& mesh, const Layout& layout) {
 }
 
 bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, int new_vertex,
-                           const RelocationOptions& options, const RerouteContext* context) {
+                           const RelocationOptions& options, const RerouteContext* context,
+                           LayoutObstacles* cache) {
   const int old_vertex = layout.nodes[node_index].vertex;
   if (new_vertex == old_vertex) return true;
   const int id = layout.nodes[node_index].id;
@@ -258,6 +291,32 @@ bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, 
   LayoutTopology before;
   if (options.full_validation) before = build_topology(mesh, layout);
 
+  // Obstacles of the layout without the node's arcs and with the node on its new vertex (the
+  // same for every splice attempt).
+  auto edge_of = [&](int a, int b) {
+    return mesh.edge_handle(mesh.find_halfedge(mesh.vertex_handle(a), mesh.vertex_handle(b))).idx();
+  };
+  RoutingObstacles base;
+  if (cache) {
+    base = cache->routing;
+    for (int a : incident) {
+      const auto& path = layout.arcs[a].path;
+      for (size_t j = 0; j < path.size(); ++j) {
+        base.vertex_blocked[path[j]] = 0;
+        if (j > 0) base.edge_blocked[edge_of(path[j - 1], path[j])] = 0;
+      }
+    }
+    base.vertex_blocked[old_vertex] = 0;
+    for (size_t n = 0; n < layout.nodes.size(); ++n)
+      if (static_cast<int>(n) != node_index) base.vertex_blocked[layout.nodes[n].vertex] = 1;
+    base.vertex_blocked[new_vertex] = 1;
+  } else {
+    Layout cleared = layout;
+    cleared.nodes[node_index].vertex = new_vertex;
+    for (int a : incident) cleared.arcs[a].path.clear();
+    base = obstacles_of_layout(mesh, cleared);
+  }
+
   for (int k = 2; k <= std::max(2, options.max_splice_edges); ++k) {
     Layout trial = layout;
     trial.nodes[node_index].vertex = new_vertex;
@@ -275,15 +334,11 @@ bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, 
       tails[i].assign(path.begin() + cut, path.end());
       arc.path.clear();
     }
-    RoutingObstacles obstacles = obstacles_of_layout(mesh, trial);
+    RoutingObstacles obstacles = base;
     for (const auto& tail : tails) {
       for (size_t j = 0; j < tail.size(); ++j) {
         obstacles.vertex_blocked[tail[j]] = 1;
-        if (j > 0) {
-          const auto h =
-              mesh.find_halfedge(mesh.vertex_handle(tail[j - 1]), mesh.vertex_handle(tail[j]));
-          obstacles.edge_blocked[mesh.edge_handle(h).idx()] = 1;
-        }
+        if (j > 0) obstacles.edge_blocked[edge_of(tail[j - 1], tail[j])] = 1;
       }
     }
     bool ok = true;
@@ -301,11 +356,7 @@ bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, 
       }
       for (size_t j = 0; j < head.size(); ++j) {
         obstacles.vertex_blocked[head[j]] = 1;
-        if (j > 0) {
-          const auto h =
-              mesh.find_halfedge(mesh.vertex_handle(head[j - 1]), mesh.vertex_handle(head[j]));
-          obstacles.edge_blocked[mesh.edge_handle(h).idx()] = 1;
-        }
+        if (j > 0) obstacles.edge_blocked[edge_of(head[j - 1], head[j])] = 1;
       }
       std::vector<int> path = head;
       path.insert(path.end(), tails[i].begin() + 1, tails[i].end());
@@ -327,6 +378,7 @@ bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, 
       }
     }
     layout = std::move(trial);
+    if (cache) cache->routing = std::move(obstacles);  // the new paths are all marked
     return true;
   }
   return false;

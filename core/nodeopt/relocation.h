@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/layout/layout.h"
+#include "core/layout/routing.h"
 #include "core/mesh/mesh.h"
 
 namespace qs {
@@ -40,6 +41,17 @@ struct RerouteContext {
 //! Fills a RerouteContext for a valid layout on \p mesh.
 RerouteContext make_reroute_context(const TriMesh& mesh, const Layout& layout);
 
+//! Routing state of a layout whose nodes move one at a time (a node optimization trial), kept up
+//! to date by move_node_and_reroute: saves rebuilding the obstacles (O(#F), with an edge look-up
+//! per arc edge) for every moved node and every splice attempt.
+struct LayoutObstacles {
+  RoutingObstacles routing;  //!< obstacles_of_layout of the current layout
+  std::vector<char> fixed;   //!< boundary vertices and vertices of feature edges (size #V)
+};
+
+//! The obstacles of \p layout on \p mesh (routing: as obstacles_of_layout).
+LayoutObstacles make_layout_obstacles(const TriMesh& mesh, const Layout& layout);
+
 //! Number of patches (face components separated by arc edges and the mesh boundary).
 //! \pre every arc path is an edge chain of \p mesh.
 int count_patches(const TriMesh& mesh, const Layout& layout);
@@ -69,6 +81,10 @@ int choose_relocation_vertex(const TriMesh& mesh, const TriMesh& original,
 //! (an index into layout.nodes).
 std::vector<char> forbidden_relocation_vertices(const TriMesh& mesh, const Layout& layout,
                                                 int node_index);
+//! The same from \p obstacles (make_layout_obstacles of \p layout): O(#V) and the node's own
+//! arcs instead of every arc path.
+std::vector<char> forbidden_relocation_vertices(const Layout& layout, int node_index,
+                                                const LayoutObstacles& obstacles);
 
 //! Moves node \p node_index of \p layout to \p new_vertex and re-routes its incident arcs: each
 //! arc keeps its old path from k edges after the node on (k = 2, 3, … max_splice_edges; the
@@ -80,11 +96,13 @@ std::vector<char> forbidden_relocation_vertices(const TriMesh& mesh, const Layou
 //! the same rotation system and patch count imply a valid layout (every patch stays a disk with
 //! the same corners), so only the nodes whose first arc edges changed and the patch count are
 //! checked (RelocationOptions::full_validation re-validates everything). \p context, when
-//! given, supplies the patch count.
+//! given, supplies the patch count. \p obstacles, when given, must hold
+//! make_layout_obstacles(mesh, layout); it is updated when the move is kept.
 //! \pre layout is valid on \p mesh (connectivity only; positions give the routing metric).
 bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, int new_vertex,
                            const RelocationOptions& options = {},
-                           const RerouteContext* context = nullptr);
+                           const RerouteContext* context = nullptr,
+                           LayoutObstacles* obstacles = nullptr);
 
 //! Same patch count and the same cyclic order of half-arcs around every node.
 bool same_layout_structure(const LayoutTopology& a, const LayoutTopology& b);

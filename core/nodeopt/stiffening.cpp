@@ -47,7 +47,7 @@ StiffeningResult stiffen(const TriMesh& mesh, const Layout& layout, const Pipeli
     p.compute_field();
     const Parameterization& r = p.compute_parameterization();
     const double E =
-        unweighted_energy(p.mesh(), p.geometry(), p.field()->theta, r.corner_uv, opt.param);
+        unweighted_energy(p.mesh(), p.geometry(), p.field()->theta, r, opt.param);
     if (it == 0) {
       out.foldovers_before = r.foldovers;
       out.E_before = E;

@@ -340,7 +340,15 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
   result_.redundant = reduction_.redundant;
   result_.unknowns = static_cast<int>(reduction_.Z.cols());
   result_.timings.setup_s = seconds_since(t0);
-  if (previous && previous != this) std::swap(solver_, previous->solver_);
+  if (previous && previous != this) {
+    std::swap(solver_, previous->solver_);
+    // The sizing Laplacian depends on the connectivity only: keep its analysis too.
+    if (options_.sizing.enabled && previous->sizing_ && previous->sizing_->same_connectivity(g) &&
+        previous->sizing_->options().clamp == options_.sizing.clamp &&
+        previous->sizing_->options().exclude_singular_faces ==
+            options_.sizing.exclude_singular_faces)
+      sizing_ = std::move(previous->sizing_);
+  }
   solve(mesh, g, theta);
 }
 
@@ -364,11 +372,41 @@ std::vector<ArcLength> ParamSolver::arc_lengths() const {
   return out;
 }
 
+std::vector<double> ParamSolver::target_scales(const TriMesh& mesh, const GeometryCache& g,
+                                               const std::vector<double>& theta) {
+  std::vector<double> scale(g.n_faces, 1.0);
+  if (!options_.sizing.enabled) {
+    result_.sizing_log_scale.clear();
+    return scale;
+  }
+  const std::vector<double>& frozen = options_.sizing.frozen_log_scale;
+  if (!frozen.empty()) {
+    if (static_cast<int>(frozen.size()) != g.n_faces)
+      throw InvalidInputError("SizingOptions::frozen_log_scale has " +
+                              std::to_string(frozen.size()) + " entries for " +
+                              std::to_string(g.n_faces) + " faces");
+    for (int f = 0; f < g.n_faces; ++f)
+      if (!std::isfinite(frozen[f]))
+        throw InvalidInputError("SizingOptions::frozen_log_scale of face " + std::to_string(f) +
+                                " is not a finite number");
+    result_.sizing_log_scale = frozen;
+  } else {
+    if (!sizing_) sizing_ = std::make_unique<SizingSolver>(mesh, g, options_.sizing);
+    result_.sizing_log_scale = sizing_->solve(mesh, g, theta, period_jump_).log_scale;
+  }
+  for (int f = 0; f < g.n_faces; ++f) scale[f] = std::exp(result_.sizing_log_scale[f]);
+  return scale;
+}
+
 const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCache& g,
                                            const std::vector<double>& theta) {
   auto t0 = std::chrono::steady_clock::now();
   const int n = system_.variables;
   const double aniso = options_.anisotropic ? options_.anisotropy : 1.0;
+  // Targets e^{s_t} u_t, e^{s_t} v_t (sizing): only the right-hand side and the constant change.
+  // The orientation constraints (solve_oriented) use the field's directions only, which the
+  // scale does not change; their QP gets the sized b.
+  const std::vector<double> scale = target_scales(mesh, g, theta);
   assembly_.clear();
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
   double constant = 0;
@@ -382,14 +420,15 @@ const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCa
     const Eigen::Matrix2d Wv = v * v.transpose() + aniso * u * u.transpose();
     const Eigen::Matrix3d Hu = area * G.transpose() * Wu * G;
     const Eigen::Matrix3d Hv = area * G.transpose() * Wv * G;
-    const Eigen::Vector3d gu = area * G.transpose() * u, gv = area * G.transpose() * v;
+    const double sf = scale[f];
+    const Eigen::Vector3d gu = sf * area * G.transpose() * u, gv = sf * area * G.transpose() * v;
     assembly_.add_face(f, Hu, Hv);
     for (int k = 0; k < 3; ++k) {
       const int w = cut_.corner_wedge[3 * f + k];
       rhs(2 * w) += gu(k);
       rhs(2 * w + 1) += gv(k);
     }
-    constant += 2 * area;
+    constant += 2 * area * sf * sf;  // u_tᵀW_u u_t = v_tᵀW_v v_t = e^{2s}
   }
   assembly_.reduce();
   const Eigen::SparseMatrix<double>& H = assembly_.H();
@@ -446,6 +485,7 @@ const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCa
 double ParamSolver::optimal_field_rotation(const TriMesh& mesh, const GeometryCache& g,
                                            const std::vector<double>& theta) {
   const int n = system_.variables;
+  const std::vector<double> scale = target_scales(mesh, g, theta);  // rotation-invariant s
   assembly_.clear();
   Eigen::VectorXd rhs0 = Eigen::VectorXd::Zero(n), rhs1 = Eigen::VectorXd::Zero(n);
   for (int f = 0; f < g.n_faces; ++f) {
@@ -455,7 +495,8 @@ double ParamSolver::optimal_field_rotation(const TriMesh& mesh, const GeometryCa
     if (!options_.face_weights.empty()) area *= options_.face_weights[f];
     const Eigen::Vector2d u(std::cos(theta[f]), std::sin(theta[f])), v(-u.y(), u.x());
     const Eigen::Matrix3d Hf = area * G.transpose() * G;
-    const Eigen::Vector3d gu = area * G.transpose() * u, gv = area * G.transpose() * v;
+    const Eigen::Vector3d gu = scale[f] * area * G.transpose() * u,
+                          gv = scale[f] * area * G.transpose() * v;
     assembly_.add_face(f, Hf, Hf);
     for (int k = 0; k < 3; ++k) {
       // φ = 0: targets (u, v); φ = 90°: targets (v, −u).
@@ -522,7 +563,11 @@ double ParamSolver::optimal_field_rotation(const TriMesh& mesh, const GeometryCa
 std::vector<double> face_energies(const TriMesh& mesh, const GeometryCache& g,
                                   const std::vector<double>& theta,
                                   const std::vector<std::array<double, 2>>& uv,
-                                  const ParamOptions& options) {
+                                  const ParamOptions& options,
+                                  const std::vector<double>& log_scale) {
+  if (!log_scale.empty() && static_cast<int>(log_scale.size()) != g.n_faces)
+    throw InvalidInputError("face_energies: " + std::to_string(log_scale.size()) +
+                            " sizing log-scales for " + std::to_string(g.n_faces) + " faces");
   const double aniso = options.anisotropic ? options.anisotropy : 1.0;
   std::vector<double> out(g.n_faces);
   for (int f = 0; f < g.n_faces; ++f) {
@@ -530,9 +575,10 @@ std::vector<double> face_energies(const TriMesh& mesh, const GeometryCache& g,
     double area;
     face_gradients(mesh, g, f, G, area);
     const Eigen::Vector2d u(std::cos(theta[f]), std::sin(theta[f])), v(-u.y(), u.x());
+    const double sf = log_scale.empty() ? 1.0 : std::exp(log_scale[f]);
     const Eigen::Vector3d cu(uv[3 * f][0], uv[3 * f + 1][0], uv[3 * f + 2][0]);
     const Eigen::Vector3d cv(uv[3 * f][1], uv[3 * f + 1][1], uv[3 * f + 2][1]);
-    const Eigen::Vector2d ru = G * cu - u, rv = G * cv - v;
+    const Eigen::Vector2d ru = G * cu - sf * u, rv = G * cv - sf * v;
     const Eigen::Matrix2d Wu = u * u.transpose() + aniso * v * v.transpose();
     const Eigen::Matrix2d Wv = v * v.transpose() + aniso * u * u.transpose();
     out[f] = area * (ru.dot(Wu * ru) + rv.dot(Wv * rv));

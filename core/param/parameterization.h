@@ -15,6 +15,7 @@
 #include "core/param/labeling.h"
 #include "core/param/orientation.h"
 #include "core/param/reduced_assembly.h"
+#include "core/param/sizing.h"
 
 namespace qs {
 
@@ -39,6 +40,9 @@ struct ParamOptions {
   //! that contradict each other (e.g. two opposite patch sides with different values) make the
   //! constraint set incompatible (InvalidInputError naming the arcs).
   std::vector<ArcLength> arc_lengths;
+  //! Curl-reducing sizing field (paper §5.3, algorithm.md §4.4, core/param/sizing.h): the
+  //! targets become e^{s_t} u_t, e^{s_t} v_t, with s recomputed from the field at every solve.
+  SizingOptions sizing;
 };
 
 struct ParamTimings {
@@ -53,7 +57,11 @@ struct Parameterization {
   //! (u, v) per face corner, size 3·#F, corner k of face f at 3f + k (GeometryCache order).
   std::vector<std::array<double, 2>> corner_uv;
   double energy = 0;  //!< E: value of energy (1) at the solution (length² units), weighted by
-                      //!< ParamOptions::face_weights when they are set
+                      //!< ParamOptions::face_weights when they are set, with the sized targets
+                      //!< when ParamOptions::sizing is enabled
+  //! Per-face log-scale s_t of the targets (ParamOptions::sizing), size #F; empty when sizing
+  //! is off (s = 0). The gradient estimator and face_energies take it with the corner values.
+  std::vector<double> sizing_log_scale;
   int foldovers = 0;  //!< faces with signed parametric area ≤ 0
   //! The orientation-constrained solve, when ParamOptions::orientation is enabled and the
   //! unconstrained solution folds (its fold-over count is orientation.foldovers_before).
@@ -87,10 +95,11 @@ class ParamSolver {
 
   //! For a field whose global rotation is free (no direction constraints): the rotation φ
   //! (radians) to add to every θ_t that minimizes the isotropic energy (1) under this solver's
-  //! constraints. With homogeneous constraints E(φ) is a quadratic form in (cos φ, sin φ), so
-  //! two extra back-substitutions give the exact optimum (φ in (−90°, 90°]). Prescribed arc
-  //! lengths add terms linear in (cos φ, sin φ); a third back-substitution and a 1-D search
-  //! over the whole circle then give the optimum (φ in (−180°, 180°]).
+  //! constraints (with sizing: the sized targets; s does not depend on a global rotation). With
+  //! homogeneous constraints E(φ) is a quadratic form in (cos φ, sin φ), so two extra
+  //! back-substitutions give the exact optimum (φ in (−90°, 90°]). Prescribed arc lengths add terms
+  //! linear in (cos φ, sin φ); a third back-substitution and a 1-D search over the whole circle
+  //! then give the optimum (φ in (−180°, 180°]).
   double optimal_field_rotation(const TriMesh& mesh, const GeometryCache& geometry,
                                 const std::vector<double>& theta);
 
@@ -119,7 +128,12 @@ class ParamSolver {
   Reduction reduction_;
   ReducedAssembly assembly_;  //!< fixed patterns of H and A = ZᵀHZ (built with reduction_)
   SpdSolver solver_{"parameterization"};
+  //! The sizing field's solver (ParamOptions::sizing.enabled), built at the first solve.
+  std::unique_ptr<SizingSolver> sizing_;
   Parameterization result_;
+  //! e^{s_t} per face for \p theta (all 1 without sizing); stores s in result_.
+  std::vector<double> target_scales(const TriMesh& mesh, const GeometryCache& geometry,
+                                    const std::vector<double>& theta);
   //! Per arc with an end node: the running-coordinate difference end − start as an affine
   //! expression in the wedge unknowns (terms, constant).
   struct ArcSpan {
@@ -130,11 +144,15 @@ class ParamSolver {
   std::vector<ArcSpan> arc_spans_;
 };
 
-//! Energy (1) per face for given corner values (same conventions as the solver). Size #F.
+//! Energy (1) per face for given corner values (same conventions as the solver), without
+//! ParamOptions::face_weights. \p log_scale: the targets' per-face log-scale s_t
+//! (Parameterization::sizing_log_scale, size #F) or empty (s = 0). Size #F.
+//! \throw InvalidInputError when log_scale is neither empty nor of size #F.
 std::vector<double> face_energies(const TriMesh& mesh, const GeometryCache& geometry,
                                   const std::vector<double>& theta,
                                   const std::vector<std::array<double, 2>>& corner_uv,
-                                  const ParamOptions& options = {});
+                                  const ParamOptions& options = {},
+                                  const std::vector<double>& log_scale = {});
 
 //! Signed parametric area (twice the area) of face f.
 double param_signed_area2(const std::vector<std::array<double, 2>>& corner_uv, int f);

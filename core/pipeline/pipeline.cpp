@@ -22,6 +22,24 @@ Pipeline::Pipeline(TriMesh mesh, Layout layout, PipelineOptions options, bool va
   geometry_ = build_geometry(mesh_);
 }
 
+Pipeline::Pipeline(TriMesh mesh, Layout layout, const Pipeline& previous)
+    : mesh_(std::move(mesh)), layout_(std::move(layout)), options_(previous.options_) {
+  if (mesh_.n_vertices() != previous.mesh_.n_vertices() ||
+      mesh_.n_faces() != previous.mesh_.n_faces())
+    throw InvalidInputError("Pipeline: the mesh has " + std::to_string(mesh_.n_vertices()) +
+                            " vertices / " + std::to_string(mesh_.n_faces()) +
+                            " faces, the previous pipeline's " +
+                            std::to_string(previous.mesh_.n_vertices()) + " / " +
+                            std::to_string(previous.mesh_.n_faces()));
+  topology_ = build_topology(mesh_, layout_);
+  geometry_ = previous.geometry_;
+  update_geometry(mesh_, geometry_);
+  if (previous.field_solver_ && !previous.field_layout_stale_) {
+    field_solver_ = std::make_unique<CrossFieldSolver>(*previous.field_solver_);
+    field_layout_stale_ = true;
+  }
+}
+
 Pipeline::~Pipeline() = default;
 
 void Pipeline::update_positions(const TriMesh& mesh) {
@@ -42,16 +60,21 @@ const CrossField& Pipeline::compute_field() {
         std::make_unique<CrossFieldSolver>(mesh_, geometry_, layout_, topology_, options_.field);
     return field_solver_->field();
   }
+  if (field_layout_stale_) {
+    const CrossField& f = field_solver_->update_layout(mesh_, geometry_, layout_, topology_);
+    field_layout_stale_ = false;
+    return f;
+  }
   return field_solver_->solve(geometry_);
 }
 
 const CrossField* Pipeline::field() const {
-  return field_solver_ ? &field_solver_->field() : nullptr;
+  return field_solver_ && !field_layout_stale_ ? &field_solver_->field() : nullptr;
 }
 
 std::vector<Singularity> Pipeline::singularities() const {
   std::vector<Singularity> out;
-  if (!field_solver_) return out;
+  if (!field_solver_ || field_layout_stale_) return out;
   const auto idx = field_quarter_indices(geometry_, field_solver_->field().theta);
   for (int v = 0; v < static_cast<int>(idx.size()); ++v)
     if (idx[v] != 0) out.push_back({v, idx[v]});
@@ -59,7 +82,8 @@ std::vector<Singularity> Pipeline::singularities() const {
 }
 
 const Parameterization& Pipeline::compute_parameterization() {
-  const CrossField& field = field_solver_ ? field_solver_->field() : compute_field();
+  const CrossField& field =
+      field_solver_ && !field_layout_stale_ ? field_solver_->field() : compute_field();
   extraction_.reset();
   if (!param_solver_) {
     // With a free rotation the solve after it counts: no orientation constraints before.

@@ -37,6 +37,21 @@ class Pipeline {
   //! With \p validate false the caller guarantees a valid layout (e.g. node optimization's
   //! re-routed layouts, checked structurally by move_node_and_reroute); validation() is empty.
   Pipeline(TriMesh mesh, Layout layout, PipelineOptions options = {}, bool validate = true);
+  //! A Pipeline for \p layout on \p previous's mesh connectivity after nodes moved to other
+  //! vertices (node optimization; same options, \p layout not validated: re-routing keeps the
+  //! structure). It reuses \p previous's work instead of starting over:
+  //! - the geometry continues \p previous's (κ continued, as update_positions);
+  //! - the cross field is a copy of \p previous's solver (sharing its factorizations) re-solved
+  //!   for the new layout by CrossFieldSolver::update_layout: new period jumps, every
+  //!   constraint back in force, warm start and drop passes as in a fresh construction, but no
+  //!   curvature and no factorization unless a drop pass needs one. Its constraint set comes
+  //!   from the geometry the field solver was first built on, so θ can differ slightly from a
+  //!   fresh Pipeline's where relocated vertices changed the curvature (equal when the vertex
+  //!   positions are the same).
+  //! The parameterization solver is built anew. Without a field in \p previous the field is
+  //! built as in a fresh Pipeline. \p previous is not changed.
+  //! \throw InvalidInputError when the vertex or face count differs.
+  Pipeline(TriMesh mesh, Layout layout, const Pipeline& previous);
   ~Pipeline();
 
   const TriMesh& mesh() const { return mesh_; }
@@ -77,6 +92,7 @@ class Pipeline {
   LayoutTopology topology_;
   GeometryCache geometry_;
   std::unique_ptr<CrossFieldSolver> field_solver_;
+  bool field_layout_stale_ = false;  //!< field_solver_ is a copy still to be update_layout'ed
   std::unique_ptr<ParamSolver> param_solver_;
   std::unique_ptr<Extraction> extraction_;
   std::unique_ptr<Curvature> curvature_;
