@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <queue>
 #include <set>
 
 #include "core/field/cross_field.h"
@@ -521,6 +522,28 @@ EmbeddingCheck check_embedding(const TriMesh& mesh, const GeometryCache& geometr
     }
   }
   return check;
+}
+
+std::vector<int> ring_vertices(const TriMesh& mesh, int v, int rings) {
+  std::vector<int> dist(mesh.n_vertices(), -1);
+  std::vector<int> out;
+  std::queue<int> queue;
+  dist[v] = 0;
+  queue.push(v);
+  while (!queue.empty()) {
+    const int a = queue.front();
+    queue.pop();
+    if (dist[a] == rings) {
+      out.push_back(a);
+      continue;
+    }
+    for (auto w : mesh.vv_range(mesh.vertex_handle(a))) {
+      if (dist[w.idx()] >= 0) continue;
+      dist[w.idx()] = dist[a] + 1;
+      queue.push(w.idx());
+    }
+  }
+  return out;
 }
 
 }  // namespace qs::test

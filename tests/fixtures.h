@@ -131,4 +131,7 @@ EmbeddingCheck check_embedding(const TriMesh& mesh, const GeometryCache& geometr
                                const LayoutTopology& topology, const Extraction& extraction,
                                const std::vector<std::array<double, 2>>& corner_uv);
 
+//! The vertices at exactly \p rings edge hops from vertex \p v (breadth-first search).
+std::vector<int> ring_vertices(const TriMesh& mesh, int v, int rings);
+
 }  // namespace qs::test

@@ -134,34 +134,12 @@ Example ellipsoid_example() {
   return e;
 }
 
-// The vertices at exactly `rings` edge rings from v.
-std::vector<int> ring_vertices(const TriMesh& mesh, int v, int rings) {
-  std::vector<int> dist(mesh.n_vertices(), -1), out;
-  std::queue<int> q;
-  dist[v] = 0;
-  q.push(v);
-  while (!q.empty()) {
-    const int a = q.front();
-    q.pop();
-    if (dist[a] == rings) {
-      out.push_back(a);
-      continue;
-    }
-    for (auto w : mesh.vv_range(mesh.vertex_handle(a)))
-      if (dist[w.idx()] < 0) {
-        dist[w.idx()] = dist[a] + 1;
-        q.push(w.idx());
-      }
-  }
-  return out;
-}
-
 // Moves every unpinned node `rings` rings away (re-routed), as a node optimization trial does.
 Layout moved_layout(const TriMesh& mesh, Layout layout, int rings, unsigned seed) {
   std::mt19937 rng(seed);
   for (int n = 0; n < static_cast<int>(layout.nodes.size()); ++n) {
     if (layout.nodes[n].pinned) continue;
-    auto cand = ring_vertices(mesh, layout.nodes[n].vertex, rings);
+    auto cand = test::ring_vertices(mesh, layout.nodes[n].vertex, rings);
     std::shuffle(cand.begin(), cand.end(), rng);
     for (int w : cand) {
       if (forbidden_relocation_vertices(mesh, layout, n)[w]) continue;
@@ -277,7 +255,7 @@ TEST(Relayout, CachedObstaclesMatchRebuiltOnes) {
       const auto forbidden_slow = forbidden_relocation_vertices(ex.mesh, slow, n);
       const auto forbidden_fast = forbidden_relocation_vertices(fast, n, cache);
       ASSERT_EQ(forbidden_slow, forbidden_fast) << "round " << round << " node " << n;
-      auto cand = ring_vertices(ex.mesh, slow.nodes[n].vertex, 1 + round % 2);
+      auto cand = test::ring_vertices(ex.mesh, slow.nodes[n].vertex, 1 + round % 2);
       std::shuffle(cand.begin(), cand.end(), rng);
       for (int w : cand) {
         if (forbidden_slow[w]) continue;

@@ -26,35 +26,12 @@
 namespace qs {
 namespace {
 
-// Vertices at exactly `rings` edge hops from `v` (BFS).
-std::vector<int> ring_vertices(const TriMesh& mesh, int v, int rings) {
-  std::vector<int> dist(mesh.n_vertices(), -1);
-  std::queue<int> q;
-  dist[v] = 0;
-  q.push(v);
-  std::vector<int> out;
-  while (!q.empty()) {
-    const int a = q.front();
-    q.pop();
-    if (dist[a] == rings) {
-      out.push_back(a);
-      continue;
-    }
-    for (auto w : mesh.vv_range(mesh.vertex_handle(a)))
-      if (dist[w.idx()] < 0) {
-        dist[w.idx()] = dist[a] + 1;
-        q.push(w.idx());
-      }
-  }
-  return out;
-}
-
 // Moves every (unpinned) node `rings` edge rings away (the choice rotates with `seed`),
 // re-routing its arcs; keeps the layout valid with the same structure.
 Layout perturb_layout(const TriMesh& mesh, Layout layout, int rings, int seed) {
   for (int n = 0; n < static_cast<int>(layout.nodes.size()); ++n) {
     if (layout.nodes[n].pinned) continue;
-    const auto cand = ring_vertices(mesh, layout.nodes[n].vertex, rings);
+    const auto cand = test::ring_vertices(mesh, layout.nodes[n].vertex, rings);
     for (size_t k = 0; k < cand.size(); ++k) {
       const int w = cand[(k + static_cast<size_t>(seed) * 7 + n * 3) % cand.size()];
       const auto forbidden = forbidden_relocation_vertices(mesh, layout, n);
@@ -521,7 +498,7 @@ TEST(DiscreteRelocation, HopSweepReturnsDisplacedNode) {
   Layout layout = in.layout;
   const int node = 2, exact_vertex = in.layout.nodes[node].vertex;
   int displaced = -1;
-  for (int w : ring_vertices(in.mesh, exact_vertex, 1))
+  for (int w : test::ring_vertices(in.mesh, exact_vertex, 1))
     if (!forbidden_relocation_vertices(in.mesh, layout, node)[w] &&
         move_node_and_reroute(in.mesh, layout, node, w)) {
       displaced = w;
@@ -663,7 +640,7 @@ TEST(Relocation, LocalCheckAgreesWithFullValidation) {
   int accepted = 0, tried = 0;
   for (int n = 0; n < static_cast<int>(in.layout.nodes.size()); ++n) {
     for (int rings = 1; rings <= 3; ++rings) {
-      for (int w : ring_vertices(in.mesh, in.layout.nodes[n].vertex, rings)) {
+      for (int w : test::ring_vertices(in.mesh, in.layout.nodes[n].vertex, rings)) {
         Layout a = in.layout, b = in.layout, c = in.layout;
         const bool ok_fast = move_node_and_reroute(in.mesh, a, n, w, fast);
         const bool ok_full = move_node_and_reroute(in.mesh, b, n, w, full);

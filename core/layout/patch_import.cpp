@@ -691,21 +691,7 @@ Layout layout_from_partition(const TriMesh& mesh, const PatchPartition& partitio
     }
     stats->centres = patch_centres;
   }
-  const ValidationResult result = validate_layout(mesh, layout);
-  if (!result.valid()) {
-    std::string msg = "the layout of the patch partition is not valid (" +
-                      std::to_string(result.errors()) + " error(s)):";
-    int shown = 0;
-    for (const auto& issue : result.issues) {
-      if (issue.severity != IssueSeverity::Error) continue;
-      if (++shown > 12) {
-        msg += "\n  ...";
-        break;
-      }
-      msg += "\n  " + format_issue(issue);
-    }
-    throw InvalidInputError(msg);
-  }
+  require_valid_layout(mesh, layout, "the layout of the patch partition");
   return layout;
 }
 

@@ -67,24 +67,6 @@ std::pair<double, double> mesh_scales(const MeshT& mesh) {
   return {mean, mesh.n_vertices() ? (hi - lo).norm() : 0.0};
 }
 
-// Throws with every validation error of a layout produced here.
-void require_valid(const TriMesh& mesh, const Layout& layout, const std::string& what) {
-  const ValidationResult result = validate_layout(mesh, layout);
-  if (result.valid()) return;
-  std::string msg =
-      what + " is not a valid layout (" + std::to_string(result.errors()) + " error(s)):";
-  int shown = 0;
-  for (const auto& issue : result.issues) {
-    if (issue.severity != IssueSeverity::Error) continue;
-    if (++shown > 12) {
-      msg += "\n  ...";
-      break;
-    }
-    msg += "\n  " + format_issue(issue);
-  }
-  throw InvalidInputError(msg);
-}
-
 // Routes a quad complex onto a target triangle mesh (see transfer_complex).
 class Transfer {
  public:
@@ -114,7 +96,7 @@ class Transfer {
     layout.mesh_faces = static_cast<int>(target_.n_faces());
     place_nodes(layout);
     route_arcs(layout);
-    require_valid(target_, layout, "the transferred layout");
+    require_valid_layout(target_, layout, "the transferred layout");
     check_cyclic_orders(layout);
     return layout;
   }
@@ -807,7 +789,7 @@ QuadImportResult import_quads(const PolyMesh& quads, const TriMesh* target,
     result.layout = layout_on_triangulation(result.quads, result.complex, options.refine);
     result.layout.mesh_vertices = static_cast<int>(result.mesh.n_vertices());
     result.layout.mesh_faces = static_cast<int>(result.mesh.n_faces());
-    require_valid(result.mesh, result.layout, "the base complex of the quad mesh");
+    require_valid_layout(result.mesh, result.layout, "the base complex of the quad mesh");
   }
   return result;
 }

@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/base/errors.h"
 #include "core/mesh/mesh_checks.h"
 
 namespace qs {
@@ -29,6 +30,23 @@ std::string format_issue(const LayoutIssue& issue) {
   ss << (issue.severity == IssueSeverity::Error ? "error" : "warning") << " [" << issue.code << "] "
      << issue.message;
   return ss.str();
+}
+
+void require_valid_layout(const TriMesh& mesh, const Layout& layout, const std::string& what) {
+  const ValidationResult result = validate_layout(mesh, layout);
+  if (result.valid()) return;
+  std::string msg =
+      what + " is not a valid layout (" + std::to_string(result.errors()) + " error(s)):";
+  int shown = 0;
+  for (const auto& issue : result.issues) {
+    if (issue.severity != IssueSeverity::Error) continue;
+    if (++shown > 12) {
+      msg += "\n  ...";
+      break;
+    }
+    msg += "\n  " + format_issue(issue);
+  }
+  throw InvalidInputError(msg);
 }
 
 namespace {

@@ -36,4 +36,9 @@ ValidationResult validate_layout(const TriMesh& mesh, const Layout& layout);
 //! One line per issue: "error [arc_crossing] arcs 3 and 7 share mesh edge (12, 13)".
 std::string format_issue(const LayoutIssue& issue);
 
+//! Validates a layout that this library produced (an import, a transfer) and throws
+//! InvalidInputError "<what> is not a valid layout (N error(s)):" listing the first 12 errors,
+//! one per line; returns quietly when it is valid.
+void require_valid_layout(const TriMesh& mesh, const Layout& layout, const std::string& what);
+
 }  // namespace qs
