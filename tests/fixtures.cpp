@@ -16,6 +16,7 @@
 #include "core/field/cross_field.h"
 #include "core/layout/routing.h"
 #include "core/mesh/mesh_checks.h"
+#include "core/nodeopt/gradient.h"
 
 namespace qs::test {
 
@@ -544,6 +545,27 @@ std::vector<int> ring_vertices(const TriMesh& mesh, int v, int rings) {
     }
   }
   return out;
+}
+
+Vec3 frozen_field_difference(const TriMesh& mesh, const GeometryCache& geometry,
+                             const std::vector<double>& theta, int v, double eps,
+                             const MovedEnergy& energy) {
+  Vec3 t[2];
+  tangent_basis(vertex_normal(mesh, geometry, v), t[0], t[1]);
+  Vec3 fd(0, 0, 0);
+  for (const Vec3& dir : t) {
+    double E[2];
+    for (int s = 0; s < 2; ++s) {
+      TriMesh moved = mesh;
+      moved.set_point(moved.vertex_handle(v),
+                      mesh.point(mesh.vertex_handle(v)) + (s == 0 ? eps : -eps) * dir);
+      GeometryCache g2 = geometry;
+      update_geometry(moved, g2);
+      E[s] = energy(moved, g2, freeze_field_after_move(moved, geometry, g2, theta, v));
+    }
+    fd += (E[0] - E[1]) / (2 * eps) * dir;
+  }
+  return fd;
 }
 
 }  // namespace qs::test

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -133,5 +134,15 @@ EmbeddingCheck check_embedding(const TriMesh& mesh, const GeometryCache& geometr
 
 //! The vertices at exactly \p rings edge hops from vertex \p v (breadth-first search).
 std::vector<int> ring_vertices(const TriMesh& mesh, int v, int rings);
+
+//! Energy of a moved mesh: (mesh, its geometry, the frozen field θ per face).
+using MovedEnergy =
+    std::function<double(const TriMesh&, const GeometryCache&, const std::vector<double>&)>;
+//! Central finite-difference gradient (tangent plane of vertex \p v, two directions) of
+//! \p energy when v moves by ±\p eps (length units), with the field frozen across the move
+//! (freeze_field_after_move). Units: energy per length.
+Vec3 frozen_field_difference(const TriMesh& mesh, const GeometryCache& geometry,
+                             const std::vector<double>& theta, int v, double eps,
+                             const MovedEnergy& energy);
 
 }  // namespace qs::test

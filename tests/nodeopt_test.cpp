@@ -77,23 +77,12 @@ double frozen_gradient_check(const FrozenCase& c, int* checked) {
   for (size_t i = 0; i < verts.size(); ++i) {
     if (est[i].norm() < 1e-3 * gmax) continue;
     const int v = verts[i];
-    Vec3 t[2];
-    tangent_basis(vertex_normal(c.mesh, g, v), t[0], t[1]);
-    Vec3 fd(0, 0, 0);
-    for (const Vec3& dir : t) {
-      double E[2];
-      for (int s = 0; s < 2; ++s) {
-        TriMesh m = c.mesh;
-        m.set_point(m.vertex_handle(v),
-                    c.mesh.point(c.mesh.vertex_handle(v)) + (s == 0 ? eps : -eps) * dir);
-        GeometryCache g2 = g;
-        update_geometry(m, g2);
-        const auto theta2 = freeze_field_after_move(m, g, g2, field.theta, v);
-        const auto& r = solver.solve(m, g2, theta2);
-        E[s] = unweighted_energy(m, g2, theta2, r.corner_uv, opt);
-      }
-      fd += (E[0] - E[1]) / (2 * eps) * dir;
-    }
+    const Vec3 fd = test::frozen_field_difference(
+        c.mesh, g, field.theta, v, eps,
+        [&](const TriMesh& m, const GeometryCache& g2, const std::vector<double>& theta2) {
+          const auto& r = solver.solve(m, g2, theta2);
+          return unweighted_energy(m, g2, theta2, r.corner_uv, opt);
+        });
     const double rel = (fd - est[i]).norm() / est[i].norm();
     worst = std::max(worst, rel);
     ++*checked;

@@ -249,23 +249,12 @@ TEST(Sizing, EstimatorMatchesFrozenDifferencesWithSizing) {
   for (size_t i = 0; i < verts.size(); ++i) {
     if (est[i].norm() < 1e-3 * gmax) continue;
     const int v = verts[i];
-    Vec3 t[2];
-    tangent_basis(vertex_normal(in.mesh, g, v), t[0], t[1]);
-    Vec3 fd(0, 0, 0);
-    for (const Vec3& dir : t) {
-      double E[2];
-      for (int s = 0; s < 2; ++s) {
-        TriMesh m = in.mesh;
-        m.set_point(m.vertex_handle(v),
-                    in.mesh.point(in.mesh.vertex_handle(v)) + (s == 0 ? eps : -eps) * dir);
-        GeometryCache g2 = g;
-        update_geometry(m, g2);
-        const auto theta2 = freeze_field_after_move(m, g, g2, field.theta, v);
-        const Parameterization& r = fixed.solve(m, g2, theta2);
-        E[s] = unweighted_energy(m, g2, theta2, r, frozen);
-      }
-      fd += (E[0] - E[1]) / (2 * eps) * dir;
-    }
+    const Vec3 fd = test::frozen_field_difference(
+        in.mesh, g, field.theta, v, eps,
+        [&](const TriMesh& m, const GeometryCache& g2, const std::vector<double>& theta2) {
+          const Parameterization& r = fixed.solve(m, g2, theta2);
+          return unweighted_energy(m, g2, theta2, r, frozen);
+        });
     worst = std::max(worst, (fd - est[i]).norm() / est[i].norm());
     unsized_gap = std::max(unsized_gap, (fd - est_unsized[i]).norm() / est[i].norm());
     ++checked;
