@@ -34,7 +34,7 @@ Pipeline::Pipeline(TriMesh mesh, Layout layout, const Pipeline& previous)
   topology_ = build_topology(mesh_, layout_);
   geometry_ = previous.geometry_;
   update_geometry(mesh_, geometry_);
-  if (previous.field_solver_ && !previous.field_layout_stale_) {
+  if (previous.field_current()) {
     field_solver_ = std::make_unique<CrossFieldSolver>(*previous.field_solver_);
     field_layout_stale_ = true;
   }
@@ -69,12 +69,12 @@ const CrossField& Pipeline::compute_field() {
 }
 
 const CrossField* Pipeline::field() const {
-  return field_solver_ && !field_layout_stale_ ? &field_solver_->field() : nullptr;
+  return field_current() ? &field_solver_->field() : nullptr;
 }
 
 std::vector<Singularity> Pipeline::singularities() const {
   std::vector<Singularity> out;
-  if (!field_solver_ || field_layout_stale_) return out;
+  if (!field_current()) return out;
   const auto idx = field_quarter_indices(geometry_, field_solver_->field().theta);
   for (int v = 0; v < static_cast<int>(idx.size()); ++v)
     if (idx[v] != 0) out.push_back({v, idx[v]});
@@ -82,8 +82,7 @@ std::vector<Singularity> Pipeline::singularities() const {
 }
 
 const Parameterization& Pipeline::compute_parameterization() {
-  const CrossField& field =
-      field_solver_ && !field_layout_stale_ ? field_solver_->field() : compute_field();
+  const CrossField& field = field_current() ? field_solver_->field() : compute_field();
   extraction_.reset();
   if (!param_solver_) {
     // With a free rotation the solve after it counts: no orientation constraints before.

@@ -93,6 +93,8 @@ class Pipeline {
   GeometryCache geometry_;
   std::unique_ptr<CrossFieldSolver> field_solver_;
   bool field_layout_stale_ = false;  //!< field_solver_ is a copy still to be update_layout'ed
+  //! A field solved for this pipeline's layout exists (not a copy awaiting update_layout).
+  bool field_current() const { return field_solver_ && !field_layout_stale_; }
   std::unique_ptr<ParamSolver> param_solver_;
   std::unique_ptr<Extraction> extraction_;
   std::unique_ptr<Curvature> curvature_;
