@@ -7,10 +7,12 @@
 #include "app/cli/commands.h"
 #include "app/cli/signals.h"
 #include "core/base/errors.h"
+#include "core/base/solver_threads.h"
 
 int main(int argc, char** argv) {
   // First of all, so that a signal during start-up is never handled by the default action.
   qs::cli::install_signal_handlers();  // SIGINT/SIGTERM: cancel, report.json "cancelled", 130/143
+  qs::limit_solver_threads_here();     // CHOLMOD's OpenMP regions: at most the idle cores
   using namespace qs::cli;
   CLI::App app{"QuadSketch: quad layout embedding via aligned parameterization (headless)",
                "quadsketch-cli"};
@@ -76,7 +78,12 @@ int main(int argc, char** argv) {
       ->excludes(sizing_on);
   cmd_opt->add_option("--sharp-angle", opt.sharp_angle_deg, "Sharp feature dihedral angle (deg)")
       ->capture_default_str();
-  cmd_opt->add_option("--threads", opt.threads, "Number of threads")->capture_default_str();
+  cmd_opt
+      ->add_option("--threads", opt.threads,
+                   "Threads of the math libraries (OpenBLAS, CHOLMOD's OpenMP regions); more "
+                   "than 1 uses at most the idle cores")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
 
   ImportQuadsOptions imp;
   auto* cmd_import = app.add_subcommand("import-quads", "Make a layout from a quad mesh");

@@ -10,6 +10,7 @@
 #include "app/cli/commands.h"
 #include "app/cli/report.h"
 #include "app/cli/signals.h"
+#include "core/base/solver_threads.h"
 #include "core/extract/quads.h"
 #include "core/layout/layout_io.h"
 #include "core/mesh/mesh_io.h"
@@ -44,6 +45,7 @@ class ProgressPrinter : public Observer {
 }  // namespace
 
 int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
+  set_solver_threads(o.threads);
   return with_report(o.out, [&](nlohmann::json& report) {
     namespace fs = std::filesystem;
     const auto t_total = std::chrono::steady_clock::now();

@@ -21,6 +21,7 @@
 #include "app/gui/pipeline_job.h"
 #include "app/gui/screenshot.h"
 #include "app/gui/thread_priority.h"
+#include "core/base/solver_threads.h"
 
 #ifndef QS_ASSETS_DIR
 #define QS_ASSETS_DIR "assets"
@@ -89,6 +90,7 @@ App::App(AppOptions options) : options_(std::move(options)) {
   worker_ = std::make_unique<Worker>(
       [nice = options_.worker_nice](WorkerState& state, const WorkerObserver& observer) {
         if (state.iteration == 0) lower_solver_thread_priority(nice);
+        limit_solver_threads_here();  // CHOLMOD's OpenMP regions: at most the idle cores
         return pipeline_step(state, observer);
       });
   doc_.editor.on_change = [this](const Layout& layout) { on_layout_edited(layout); };

@@ -4,7 +4,11 @@
 
 namespace qs {
 
+// Ids are usually the positions (files written by us, imports, the editor before deletions), so
+// that is tried first; otherwise a linear search. Both lookups run once per arc end in
+// build_topology and validation, which made them quadratic on layouts with thousands of arcs.
 int Layout::node_index(int id) const {
+  if (id >= 0 && static_cast<size_t>(id) < nodes.size() && nodes[id].id == id) return id;
   for (size_t i = 0; i < nodes.size(); ++i)
     if (nodes[i].id == id) return static_cast<int>(i);
   return -1;
@@ -23,6 +27,7 @@ bool same_cycle(const std::vector<int>& a, const std::vector<int>& b) {
 }
 
 int Layout::arc_index(int id) const {
+  if (id >= 0 && static_cast<size_t>(id) < arcs.size() && arcs[id].id == id) return id;
   for (size_t i = 0; i < arcs.size(); ++i)
     if (arcs[i].id == id) return static_cast<int>(i);
   return -1;

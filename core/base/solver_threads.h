@@ -1,0 +1,31 @@
+// Threads of the math libraries under the solvers: OpenBLAS's thread pool (dense kernels of
+// CHOLMOD's supernodal factorization) and the OpenMP regions inside CHOLMOD.
+//
+// Debian's CHOLMOD (SuiteSparse 5.12) is built with CHOLMOD_OMP_NUM_THREADS = 4: each supernode
+// of a factorization opens parallel regions with 4 threads whatever OMP_NUM_THREADS says. On
+// small and medium systems (all of a node-optimization step's solves) waking and parking those
+// threads costs far more than the arithmetic: on the bundled example `optimize` spent 1.3 s in
+// the kernel (futex / sched_yield) for 0.4 s of user time. Only OMP_THREAD_LIMIT in the
+// environment caps such a clause, and libgomp reads it before main(), so the cap here works per
+// thread instead: OpenMP's per-thread settings are applied by limit_solver_threads_here() in
+// every thread that calls CHOLMOD (SpdSolver does it).
+#pragma once
+
+namespace qs {
+
+//! Sets how many threads the math libraries may use, process-wide (n ≥ 1; 0 restores the
+//! default, 2). OpenBLAS's pool is resized at once (when the library is OpenBLAS); the OpenMP
+//! part takes effect in each solver thread at its next limit_solver_threads_here().
+void set_solver_threads(int n);
+
+//! The current limit (≥ 1).
+int solver_threads();
+
+//! Applies the limit to the calling thread's OpenMP settings: with 1 thread, parallel regions
+//! run serially (max active levels 0); with more, libgomp's dynamic adjustment is switched on,
+//! so a region gets at most as many threads as the machine has idle cores (never CHOLMOD's 4
+//! on 2 cores). A no-op after the first call in a thread until the limit changes. Safe when
+//! OpenMP or OpenBLAS is absent (looked up at run time).
+void limit_solver_threads_here();
+
+}  // namespace qs
