@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/base/errors.h"
+#include "core/base/solver_threads.h"
 #include "core/base/timing.h"
 
 namespace qs {
@@ -94,6 +95,7 @@ void SpdSolver::detach(bool keep_analysis) {
 
 void SpdSolver::analyze(const Eigen::SparseMatrix<double>& A) {
   if (A.rows() != A.cols()) throw SolverError(stage_ + ": matrix is not square");
+  limit_solver_threads_here();
   detach(false);
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<int> hint = std::move(ordering_hint_);
@@ -123,6 +125,7 @@ void SpdSolver::analyze(const Eigen::SparseMatrix<double>& A) {
 }
 
 void SpdSolver::factorize(const Eigen::SparseMatrix<double>& A) {
+  limit_solver_threads_here();  // CHOLMOD's OpenMP regions (solver_threads.h)
   if (!same_pattern(A))
     analyze(A);
   else
