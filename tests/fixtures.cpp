@@ -15,6 +15,7 @@
 
 #include "core/field/cross_field.h"
 #include "core/layout/routing.h"
+#include "core/layout/validate.h"
 #include "core/mesh/mesh_checks.h"
 #include "core/nodeopt/gradient.h"
 
@@ -146,6 +147,79 @@ MeshAndLayout cube_sphere(int k, Vec3 radii, bool project) {
       out.layout.arcs.push_back(make_arc(arc_id, id, to, std::move(path)));
     }
   }
+  return out;
+}
+
+TriMesh icosphere(int subdivisions, Vec3 radii) {
+  const double t = (1 + std::sqrt(5.0)) / 2;
+  std::vector<Vec3> points = {Vec3(-1, t, 0), Vec3(1, t, 0), Vec3(-1, -t, 0), Vec3(1, -t, 0),
+                              Vec3(0, -1, t), Vec3(0, 1, t), Vec3(0, -1, -t), Vec3(0, 1, -t),
+                              Vec3(t, 0, -1), Vec3(t, 0, 1), Vec3(-t, 0, -1), Vec3(-t, 0, 1)};
+  for (auto& p : points) p.normalize();
+  std::vector<std::array<int, 3>> faces = {
+      {0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+      {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+      {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  for (int level = 0; level < subdivisions; ++level) {
+    std::map<std::pair<int, int>, int> midpoint;
+    auto mid = [&](int a, int b) {
+      const auto key = std::minmax(a, b);
+      const auto it = midpoint.find(key);
+      if (it != midpoint.end()) return it->second;
+      points.push_back((points[a] + points[b]).normalized());
+      return midpoint[key] = static_cast<int>(points.size()) - 1;
+    };
+    std::vector<std::array<int, 3>> finer;
+    for (const auto& f : faces) {
+      const int a = mid(f[0], f[1]), b = mid(f[1], f[2]), c = mid(f[2], f[0]);
+      finer.insert(finer.end(), {{f[0], a, c}, {f[1], b, a}, {f[2], c, b}, {a, b, c}});
+    }
+    faces = std::move(finer);
+  }
+  TriMesh mesh;
+  for (const auto& p : points)
+    mesh.add_vertex(Vec3(p[0] * radii[0], p[1] * radii[1], p[2] * radii[2]));
+  for (const auto& f : faces)
+    mesh.add_face(mesh.vertex_handle(f[0]), mesh.vertex_handle(f[1]), mesh.vertex_handle(f[2]));
+  return mesh;
+}
+
+Layout transfer_layout(const MeshAndLayout& source, const TriMesh& target) {
+  auto nearest = [&](int source_vertex) {
+    const Vec3 q = source.mesh.point(source.mesh.vertex_handle(source_vertex));
+    int best = -1;
+    double best_d = 0;
+    for (auto v : target.vertices()) {
+      const double d = (target.point(v) - q).sqrnorm();
+      if (best < 0 || d < best_d) {
+        best = v.idx();
+        best_d = d;
+      }
+    }
+    return best;
+  };
+  Layout out = source.layout;
+  for (auto& n : out.nodes) n.vertex = nearest(n.vertex);
+  for (auto& arc : out.arcs) {
+    const std::vector<int> path = std::move(arc.path);
+    arc.path.clear();
+    arc.points.clear();
+    int last = -1;
+    for (size_t i = 2; i + 2 < path.size(); i += 2) {
+      const int w = nearest(path[i]);
+      if (w == last) continue;
+      last = w;
+      // The point at vertex w: barycentric 1 at w's corner of one incident face.
+      const auto fh = *target.vf_range(target.vertex_handle(w)).begin();
+      SurfacePoint sp;
+      sp.face = fh.idx();
+      int corner = 0;
+      for (auto vh : target.fv_range(fh)) sp.bary[corner++] = vh.idx() == w ? 1.0 : 0.0;
+      arc.points.push_back(sp);
+    }
+  }
+  route_layout(target, out);
+  require_valid_layout(target, out, "the transferred layout");
   return out;
 }
 

@@ -35,6 +35,17 @@ struct MeshAndLayout {
 //! cube corners (valence 3) and the 12 cube edges (each a path of k mesh edges): 6 patches.
 MeshAndLayout cube_sphere(int k, Vec3 radii = Vec3(1, 1, 1), bool project = true);
 
+//! Icosahedron subdivided \p subdivisions times (each triangle into 4), projected onto the
+//! ellipsoid with the given radii: 20·4^subdivisions faces, vertices of valence 5 and 6 that
+//! follow no cube or layout structure.
+TriMesh icosphere(int subdivisions, Vec3 radii = Vec3(1, 1, 1));
+
+//! The layout of \p source moved onto \p target, a different mesh of the same surface: each node
+//! goes to the target vertex nearest to its source vertex (3D distance), each arc is routed
+//! (route_layout) through the target vertices nearest to every second interior vertex of its
+//! source path. \throw InvalidInputError if an arc cannot be routed or the result is invalid.
+Layout transfer_layout(const MeshAndLayout& source, const TriMesh& target);
+
 //! Torus (radii R, r) with an nu×nv quad grid (split into triangles). Layout: a pu×pv grid of
 //! valence-4 nodes with arcs along grid lines (nu % pu == 0, nv % pv == 0). Genus 1, no
 //! singularities.
