@@ -4,9 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <numeric>
+#include <set>
 
 #include "core/base/errors.h"
 #include "core/field/cross_field.h"
@@ -208,6 +210,129 @@ TEST(CageLayout, RefinedFittedCageStaysOnTheSurface) {
   EXPECT_LT(worst, 0.01);
   // The base complex keeps its nodes: split vertices are regular.
   EXPECT_EQ(base_complex(cage).node_vertex.size(), base_complex(fitted).node_vertex.size());
+}
+
+int irregular_vertices(const PolyMesh& quads) {
+  int n = 0;
+  for (const auto v : quads.vertices()) n += quads.valence(v) != 4;
+  return n;
+}
+
+TEST(CageLayout, CancellingIrregularVerticesKeepsAClosedQuadMeshOfTheGenus) {
+  const TriMesh mesh = test::torus_grid(96, 32, 1, 1).mesh;
+  for (const int rounds : {0, 5}) {
+    VoxelCageInfo info;
+    const PolyMesh cage = voxel_cage(mesh, 10, &info);
+    ASSERT_EQ(info.genus, 1);
+    PolyMesh quads = cage;
+    QuadSimplifyOptions options;
+    options.rounds = rounds;
+    options.depth = 2;
+    std::vector<int> kept;
+    const CageSimplifyStats st = cancel_irregular_vertices(quads, options, nullptr, &kept);
+    EXPECT_TRUE(is_pure_quad(quads));
+    MeshReport report;
+    count_topology(quads, report);
+    EXPECT_EQ(report.genus, 1);
+    EXPECT_EQ(report.components, 1);
+    EXPECT_EQ(report.boundary_loops, 0);
+    for (const auto v : quads.vertices()) EXPECT_GE(quads.valence(v), 3u);
+    EXPECT_EQ(st.irregular_before, irregular_vertices(cage));
+    EXPECT_EQ(st.irregular_after, irregular_vertices(quads));
+    EXPECT_LT(st.irregular_after, st.irregular_before) << "rounds " << rounds;
+    // A collapse removes one quad and moves one vertex (to a midpoint); a rotation neither.
+    EXPECT_EQ(st.quads_after, st.quads_before - st.collapses);
+    EXPECT_EQ(static_cast<int>(quads.n_faces()), st.quads_after);
+    ASSERT_EQ(kept.size(), quads.n_vertices());
+    EXPECT_TRUE(std::is_sorted(kept.begin(), kept.end()));
+    int moved = 0;
+    for (const auto v : quads.vertices()) moved += quads.point(v) != cage.point(VH(kept[v.idx()]));
+    EXPECT_LE(moved, st.collapses);
+    std::printf(
+        "[stat] torus voxel cage (rounds %d): %d -> %d irregular vertices, %d -> %d quads\n",
+        rounds, st.irregular_before, st.irregular_after, st.quads_before, st.quads_after);
+  }
+}
+
+TEST(CageLayout, CancellingWithNormalsKeepsCornersWithinTheAngleRange) {
+  // The voxel cage of a torus: every quad is a square on a cube face. With normals, no face an
+  // operation makes may turn against them or have a corner sharper than asin(0.5) = 30°.
+  const TriMesh mesh = test::torus_grid(96, 32, 1, 1).mesh;
+  VoxelCageInfo info;
+  PolyMesh quads = voxel_cage(mesh, 8, &info);
+  ASSERT_EQ(info.genus, 1);
+  std::vector<Vec3> normals;
+  for (const auto v : quads.vertices()) {
+    Vec3 n(0, 0, 0);
+    for (const auto f : quads.vf_range(v)) n += quads.calc_face_normal(f);
+    normals.push_back(n / n.norm());
+  }
+  const int irregular = irregular_vertices(quads);
+  const std::vector<Vec3> positions(quads.points(), quads.points() + quads.n_vertices());
+  std::set<std::array<int, 4>> original;
+  for (const auto f : quads.faces()) {
+    std::array<int, 4> q{};
+    int k = 0;
+    for (const auto v : quads.fv_range(f)) q[k++] = v.idx();
+    std::sort(q.begin(), q.end());
+    original.insert(q);
+  }
+  std::vector<int> kept;
+  const CageSimplifyStats st = cancel_irregular_vertices(quads, {}, &normals, &kept);
+  EXPECT_EQ(st.irregular_before, irregular);
+  EXPECT_LT(st.irregular_after, st.irregular_before);
+  // The faces an operation made, on vertices that did not move (rotations; a merged vertex
+  // takes a mean normal the test does not know).
+  int checked = 0;
+  for (const auto f : quads.faces()) {
+    std::vector<VH> vs(quads.fv_begin(f), quads.fv_end(f));
+    std::array<int, 4> q{};
+    bool unmoved = true;
+    for (int i = 0; i < 4; ++i) {
+      q[i] = kept[vs[i].idx()];
+      unmoved = unmoved && quads.point(vs[i]) == positions[q[i]];
+    }
+    std::sort(q.begin(), q.end());
+    if (!unmoved || original.count(q)) continue;
+    ++checked;
+    for (int i = 0; i < 4; ++i) {
+      const Vec3 p = quads.point(vs[i]);
+      const Vec3 e1 = quads.point(vs[(i + 1) % 4]) - p, e2 = quads.point(vs[(i + 3) % 4]) - p;
+      EXPECT_GT(OpenMesh::dot(OpenMesh::cross(e1, e2), normals[kept[vs[i].idx()]]),
+                0.5 * e1.norm() * e2.norm())
+          << "face " << f.idx() << " corner " << i;
+    }
+  }
+  EXPECT_GT(checked, 0);  // this cage is simplified by edge rotations
+  std::printf(
+      "[stat] torus voxel cage with normals: %d -> %d irregular vertices, %d new faces "
+      "checked\n",
+      st.irregular_before, st.irregular_after, checked);
+}
+
+TEST(CageLayout, SimplifiedLayoutHasFewerIrregularNodes) {
+  const TriMesh mesh = test::cube_sphere(24).mesh;
+  CageOptions options;
+  options.resolution = 8;
+  options.attempts = 1;
+  const CageResult plain = cage_layout(mesh, options);
+  options.simplify = true;
+  const CageResult simplified = cage_layout(mesh, options);
+  ASSERT_TRUE(simplified.simplified) << (simplified.warnings.empty() ? "" : simplified.warnings[0]);
+  expect_valid_closed_layout(mesh, simplified.layout);
+  auto irregular_nodes = [&](const Layout& layout) {
+    const LayoutTopology topo = build_topology(mesh, layout);
+    int n = 0;
+    for (int v : topo.valence) n += v != 4;
+    return n;
+  };
+  EXPECT_EQ(irregular_nodes(simplified.layout), simplified.simplify.irregular_after);
+  EXPECT_LT(irregular_nodes(simplified.layout), irregular_nodes(plain.layout));
+  // Nodes are the first vertices of the split coarse mesh, arcs its coarse edges.
+  EXPECT_EQ(simplified.complex.num_patches * 16, static_cast<int>(simplified.cage.n_faces()));
+  std::printf("[stat] sphere: irregular nodes %d (plain) -> %d (simplified), patches %d -> %d\n",
+              irregular_nodes(plain.layout), irregular_nodes(simplified.layout),
+              plain.complex.num_patches, simplified.complex.num_patches);
 }
 
 TEST(CageLayout, RefusesMeshesWithBoundaryAndWrongResolutions) {

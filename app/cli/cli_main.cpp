@@ -140,6 +140,9 @@ int main(int argc, char** argv) {
                    "inside fraction)")
       ->check(CLI::Range(1, 8))
       ->capture_default_str();
+  cmd_cage->add_flag("--simplify", cage.simplify,
+                     "Cancel nearby irregular nodes of the coarsened cage layout (diagonal "
+                     "collapses, edge rotations) and re-embed it; falls back to the plain layout");
   cmd_cage->add_option("--cage", cage.cage, "Also write the fitted quad cage (OBJ)");
 
   try {

@@ -51,6 +51,7 @@ int run_cage_layout(const CageLayoutOptions& o, const CommonOptions& common) {
   options.coarsen = o.coarsen;
   options.fit.iterations = o.smoothing;
   options.subsamples = o.subsamples;
+  options.simplify = o.simplify;
   const CageResult result = cage_layout(mesh, options);
   for (const auto& w : result.warnings) std::cerr << "warning: " << w << "\n";
   const auto parent = std::filesystem::path(o.out).parent_path();
@@ -66,6 +67,11 @@ int run_cage_layout(const CageLayoutOptions& o, const CommonOptions& common) {
     std::cerr << "cage-layout: resolution " << result.resolution
               << (result.shift != 0 ? " (shifted " + format_shift(result.shift) + " cell)" : "")
               << (result.refined ? ", split " + std::to_string(result.refined) + "x" : "")
+              << (result.simplified
+                      ? ", simplified (irregular nodes " +
+                            std::to_string(result.simplify.irregular_before) + " -> " +
+                            std::to_string(result.simplify.irregular_after) + ")"
+                      : "")
               << ", cage " << result.cage.n_faces() << " quads (genus " << result.voxels.genus
               << ", " << result.voxels.flipped_cells << " cells flipped for manifoldness, "
               << result.folded_quads << " folded after fitting, " << result.coarsen.patches_before

@@ -52,6 +52,7 @@ struct CageLayoutOptions {
   bool all_edges = false;  //!< every cage edge is an arc (one patch per cage quad)
   double coarsen = 1.5;    //!< collapse cage chords at most this many voxel cells wide (0: off)
   int subsamples = 1;      //!< inside-test points per cell and axis (CageOptions::subsamples)
+  bool simplify = false;   //!< cancel nearby irregular layout nodes (CageOptions::simplify)
 };
 
 struct PerturbOptions {

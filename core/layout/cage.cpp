@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <limits>
+#include <numeric>
 #include <string>
 
 #include "core/base/errors.h"
@@ -480,6 +482,36 @@ void refine_fitted_cage(PolyMesh& cage, const TriMesh& mesh) {
   }
 }
 
+namespace {
+
+// Umbrella smoothing of all vertices, each round followed by a closest-point projection onto
+// faces facing the same way as the quad mesh at the vertex.
+void relax_vertices(PolyMesh& quads, const TriMesh& mesh, int iterations) {
+  if (iterations <= 0 || quads.n_vertices() == 0) return;
+  double mean_edge = 0;
+  for (const auto e : quads.edges()) mean_edge += quads.calc_edge_length(e);
+  mean_edge /= std::max<size_t>(1, quads.n_edges());
+  SidedProjector projector(mesh, mean_edge);
+  std::vector<Vec3> next(quads.n_vertices());
+  for (int it = 0; it < iterations; ++it) {
+    for (const auto v : quads.vertices()) {
+      Vec3 sum(0, 0, 0);
+      int count = 0;
+      for (const auto w : quads.vv_range(v)) {
+        sum += quads.point(w);
+        ++count;
+      }
+      next[v.idx()] = count ? sum / count : quads.point(v);
+    }
+    for (const auto v : quads.vertices()) {
+      const Vec3 n = cage_vertex_normal(quads, v);
+      quads.set_point(v, projector.project(next[v.idx()], n, 3.0 * mean_edge).point);
+    }
+  }
+}
+
+}  // namespace
+
 int fit_cage(PolyMesh& cage, const TriMesh& mesh, const CageFitOptions& options) {
   const size_t nv = cage.n_vertices();
   if (nv == 0) return 0;
@@ -559,6 +591,591 @@ int fit_cage(PolyMesh& cage, const TriMesh& mesh, const CageFitOptions& options)
   return folded;
 }
 
+namespace {
+
+// A closed quad mesh as a face list with vertex-face incidences, edited by diagonal collapses
+// and edge rotations, with an undo journal (cancel_irregular_vertices).
+class QuadEditor {
+ public:
+  // \p normals (per vertex, unit; may be empty): the surface normal at each vertex; when given,
+  // every face an operation makes or changes must turn the normals' way at each corner, with
+  // sin(corner angle) > min_sine.
+  QuadEditor(const PolyMesh& quads, std::vector<Vec3> normals, double min_sine)
+      : normal_(std::move(normals)), min_sine_(min_sine) {
+    pos_.reserve(quads.n_vertices());
+    for (const auto v : quads.vertices()) pos_.push_back(quads.point(v));
+    vfaces_.resize(quads.n_vertices());
+    for (const auto f : quads.faces()) {
+      std::array<int, 4> q{};
+      int k = 0;
+      for (const auto v : quads.fv_range(f)) q[k++] = v.idx();
+      face_.push_back(q);
+      alive_.push_back(1);
+      for (int v : q) vfaces_[v].push_back(f.idx());
+    }
+  }
+
+  // An operation and how much it lowers Σ (valence − 4)².
+  struct Op {
+    int gain = std::numeric_limits<int>::min();
+    bool collapse = false;
+    int f = -1, g = -1;             // collapse: face f; rotation: the two faces
+    int a = -1, c = -1;             // collapse: merged corners (c into a)
+    std::array<int, 4> q1{}, q2{};  // rotation: the new faces
+    bool valid() const { return f >= 0; }
+  };
+
+  int valence(int v) const { return static_cast<int>(vfaces_[v].size()); }
+  static int cost(int valence) { return (valence - 4) * (valence - 4); }
+  bool face_alive(int f) const { return alive_[f] != 0; }
+  const std::array<int, 4>& face(int f) const { return face_[f]; }
+  const std::vector<int>& faces_of(int v) const { return vfaces_[v]; }
+  size_t num_faces() const { return face_.size(); }
+  size_t num_vertices() const { return vfaces_.size(); }
+
+  bool adjacent(int u, int v) const {
+    for (int f : vfaces_[u]) {
+      const auto& q = face_[f];
+      const int k = index_in(q, u);
+      if (q[(k + 1) % 4] == v || q[(k + 3) % 4] == v) return true;
+    }
+    return false;
+  }
+
+  void neighbours(int v, std::vector<int>& out) const {
+    out.clear();
+    for (int f : vfaces_[v]) {
+      const auto& q = face_[f];
+      const int k = index_in(q, v);
+      out.push_back(q[(k + 1) % 4]);
+      out.push_back(q[(k + 3) % 4]);
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  }
+
+  // Best diagonal collapse of face f.
+  Op best_collapse(int f) const {
+    Op best;
+    const auto& q = face_[f];
+    std::vector<int> na, nc, common;
+    for (int k = 0; k < 2; ++k) {
+      const int a = q[k], b = q[k + 1], c = q[(k + 2) % 4], d = q[(k + 3) % 4];
+      const int va = valence(a), vb = valence(b), vc = valence(c), vd = valence(d);
+      if (vb < 4 || vd < 4 || va + vc - 2 > kMaxValence) continue;
+      neighbours(a, na);
+      neighbours(c, nc);
+      if (std::binary_search(na.begin(), na.end(), c)) continue;
+      common.clear();
+      std::set_intersection(na.begin(), na.end(), nc.begin(), nc.end(), std::back_inserter(common));
+      if (common.size() != 2) continue;  // {b, d}; more would pinch the surface
+      int shared = 0;
+      for (int g : vfaces_[a]) shared += index_in(face_[g], c) >= 0;
+      if (shared != 1) continue;
+      const int gain = cost(va) + cost(vb) + cost(vc) + cost(vd) - cost(va + vc - 2) -
+                       cost(vb - 1) - cost(vd - 1);
+      if (gain > best.gain && !normal_.empty()) {
+        // The faces around a and c with both at their midpoint.
+        const Vec3 m = 0.5 * (pos_[a] + pos_[c]);
+        Vec3 nm = normal_[a] + normal_[c];
+        nm /= std::max(1e-12, nm.norm());
+        bool ok = true;
+        for (int w : {a, c}) {
+          for (int g : vfaces_[w]) {
+            if (g == f || !ok) continue;
+            std::array<Vec3, 4> p, n;
+            for (int i = 0; i < 4; ++i) {
+              const int x = face_[g][i];
+              p[i] = (x == a || x == c) ? m : pos_[x];
+              n[i] = (x == a || x == c) ? nm : normal_[x];
+            }
+            ok = convex(p, n);
+          }
+        }
+        if (!ok) continue;
+      }
+      if (gain > best.gain) {
+        best.gain = gain;
+        best.collapse = true;
+        best.f = f;
+        best.a = a;
+        best.c = c;
+      }
+    }
+    return best;
+  }
+
+  // Best rotation of the edge from q[k] to q[k + 1] of face f.
+  Op best_rotation(int f, int k) const {
+    Op best;
+    const auto& q1 = face_[f];
+    const int u = q1[k], v = q1[(k + 1) % 4], p = q1[(k + 2) % 4], pq = q1[(k + 3) % 4];
+    if (valence(u) < 4 || valence(v) < 4) return best;
+    int g = -1, k2 = -1;
+    for (int h : vfaces_[v]) {
+      const int i = index_in(face_[h], v);
+      if (h != f && face_[h][(i + 1) % 4] == u) g = h, k2 = i;
+    }
+    if (g < 0) return best;
+    const auto& q2 = face_[g];
+    const int r = q2[(k2 + 2) % 4], s = q2[(k2 + 3) % 4];
+    std::array<int, 6> six{u, v, p, pq, r, s};
+    std::sort(six.begin(), six.end());
+    if (std::adjacent_find(six.begin(), six.end()) != six.end()) return best;
+    // The hexagon v, p, pq, u, r, s split along p–r or pq–s instead of u–v.
+    const int x[2] = {p, pq}, y[2] = {r, s};
+    for (int option = 0; option < 2; ++option) {
+      if (valence(x[option]) + 1 > kMaxValence || valence(y[option]) + 1 > kMaxValence) continue;
+      if (adjacent(x[option], y[option])) continue;
+      if (!normal_.empty()) {
+        const std::array<int, 4> n1 =
+            option == 0 ? std::array<int, 4>{p, pq, u, r} : std::array<int, 4>{pq, u, r, s};
+        const std::array<int, 4> n2 =
+            option == 0 ? std::array<int, 4>{r, s, v, p} : std::array<int, 4>{s, v, p, pq};
+        if (!convex_face(n1) || !convex_face(n2)) continue;
+      }
+      const int gain = cost(valence(u)) + cost(valence(v)) + cost(valence(x[option])) +
+                       cost(valence(y[option])) - cost(valence(u) - 1) - cost(valence(v) - 1) -
+                       cost(valence(x[option]) + 1) - cost(valence(y[option]) + 1);
+      if (gain > best.gain) {
+        best.gain = gain;
+        best.collapse = false;
+        best.f = f;
+        best.g = g;
+        if (option == 0) {
+          best.q1 = {p, pq, u, r};
+          best.q2 = {r, s, v, p};
+        } else {
+          best.q1 = {pq, u, r, s};
+          best.q2 = {s, v, p, pq};
+        }
+      }
+    }
+    return best;
+  }
+
+  // Best operation on face f (its collapse or the rotation of one of its edges).
+  Op best_at(int f) const {
+    Op best = best_collapse(f);
+    for (int k = 0; k < 4; ++k) {
+      const Op r = best_rotation(f, k);
+      if (r.gain > best.gain) best = r;
+    }
+    return best;
+  }
+
+  void apply(const Op& op) {
+    if (op.collapse) {
+      const std::array<int, 4> old = face_[op.f];
+      set_face(op.f, old, false);
+      set_position(op.a, 0.5 * (pos_[op.a] + pos_[op.c]));
+      if (!normal_.empty()) {
+        Vec3 nm = normal_[op.a] + normal_[op.c];
+        normal_[op.a] = nm / std::max(1e-12, nm.norm());
+      }
+      const std::vector<int> around = vfaces_[op.c];
+      for (int g : around) {
+        std::array<int, 4> q = face_[g];
+        for (int& v : q)
+          if (v == op.c) v = op.a;
+        set_face(g, q, true);
+      }
+    } else {
+      set_face(op.f, op.q1, true);
+      set_face(op.g, op.q2, true);
+    }
+  }
+
+  // The journal position to undo back to.
+  size_t mark() const { return journal_.size(); }
+  void undo(size_t to) {
+    while (journal_.size() > to) {
+      const Entry e = journal_.back();
+      journal_.pop_back();
+      if (e.face >= 0) {
+        replace(e.face, e.quad, e.alive);
+      } else {
+        pos_[e.vertex] = e.position;
+        if (!normal_.empty()) normal_[e.vertex] = e.normal;
+      }
+    }
+  }
+  void forget() { journal_.clear(); }
+
+  const Vec3& position(int v) const { return pos_[v]; }
+
+ private:
+  static constexpr int kMaxValence = 8;
+  struct Entry {
+    int face = -1;  // face entry, or -1 for a position entry
+    std::array<int, 4> quad{};
+    bool alive = false;
+    int vertex = -1;
+    Vec3 position{0, 0, 0}, normal{0, 0, 0};
+  };
+
+  // Every corner turns the way of the normal there, with sin(angle) > min_sine_.
+  bool convex(const std::array<Vec3, 4>& p, const std::array<Vec3, 4>& n) const {
+    for (int i = 0; i < 4; ++i) {
+      const Vec3 e1 = p[(i + 1) % 4] - p[i], e2 = p[(i + 3) % 4] - p[i];
+      if (OpenMesh::dot(OpenMesh::cross(e1, e2), n[i]) <= min_sine_ * e1.norm() * e2.norm())
+        return false;
+    }
+    return true;
+  }
+  bool convex_face(const std::array<int, 4>& q) const {
+    std::array<Vec3, 4> p, n;
+    for (int i = 0; i < 4; ++i) p[i] = pos_[q[i]], n[i] = normal_[q[i]];
+    return convex(p, n);
+  }
+
+  static int index_in(const std::array<int, 4>& q, int v) {
+    for (int i = 0; i < 4; ++i)
+      if (q[i] == v) return i;
+    return -1;
+  }
+
+  void replace(int f, const std::array<int, 4>& q, bool alive) {
+    if (alive_[f]) {
+      for (int v : face_[f]) {
+        auto& list = vfaces_[v];
+        list.erase(std::find(list.begin(), list.end(), f));
+      }
+    }
+    face_[f] = q;
+    alive_[f] = alive;
+    if (alive)
+      for (int v : q) vfaces_[v].push_back(f);
+  }
+  void set_face(int f, const std::array<int, 4>& q, bool alive) {
+    Entry e;
+    e.face = f;
+    e.quad = face_[f];
+    e.alive = alive_[f] != 0;
+    journal_.push_back(e);
+    replace(f, q, alive);
+  }
+  void set_position(int v, const Vec3& p) {
+    Entry e;
+    e.vertex = v;
+    e.position = pos_[v];
+    if (!normal_.empty()) e.normal = normal_[v];
+    journal_.push_back(e);
+    pos_[v] = p;
+  }
+
+  std::vector<Vec3> pos_;
+  std::vector<Vec3> normal_;
+  double min_sine_ = 0;
+  std::vector<std::array<int, 4>> face_;
+  std::vector<char> alive_;
+  std::vector<std::vector<int>> vfaces_;
+  std::vector<Entry> journal_;
+};
+
+int count_irregular(const QuadEditor& ed) {
+  int n = 0;
+  for (size_t v = 0; v < ed.num_vertices(); ++v) {
+    const int val = ed.valence(static_cast<int>(v));
+    n += val > 0 && val != 4;
+  }
+  return n;
+}
+
+// Applies improving operations until there is none; returns how many.
+int greedy_pass(QuadEditor& ed, int& collapses, int& rotations) {
+  int applied = 0;
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (size_t f = 0; f < ed.num_faces(); ++f) {
+      if (!ed.face_alive(static_cast<int>(f))) continue;
+      const QuadEditor::Op op = ed.best_at(static_cast<int>(f));
+      if (op.valid() && op.gain > 0) {
+        ed.apply(op);
+        ++(op.collapse ? collapses : rotations);
+        ++applied;
+        changed = true;
+      }
+    }
+  }
+  return applied;
+}
+
+// Faces within two rings of the given vertices.
+std::vector<int> faces_near(const QuadEditor& ed, const std::vector<int>& vertices) {
+  std::vector<int> ring, out;
+  for (int v : vertices)
+    for (int f : ed.faces_of(v))
+      for (int w : ed.face(f)) ring.push_back(w);
+  std::sort(ring.begin(), ring.end());
+  ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+  for (int v : ring)
+    for (int f : ed.faces_of(v)) out.push_back(f);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+// Tries neutral operations at the faces around \p vertices, each followed by the best
+// operation near it when that one improves, else (depth > 1) by further neutral operations at
+// the irregular vertices it touched. Keeps the first sequence that ends improving; undoes the
+// rest.
+bool look_ahead(QuadEditor& ed, const std::vector<int>& vertices, int depth,
+                CageSimplifyStats& st) {
+  std::vector<int> around;
+  for (int v : vertices) around.insert(around.end(), ed.faces_of(v).begin(), ed.faces_of(v).end());
+  std::sort(around.begin(), around.end());
+  around.erase(std::unique(around.begin(), around.end()), around.end());
+  std::vector<QuadEditor::Op> neutral;
+  for (int f : around) {
+    const QuadEditor::Op c = ed.best_collapse(f);
+    if (c.valid() && c.gain == 0) neutral.push_back(c);
+    for (int k = 0; k < 4; ++k) {
+      const QuadEditor::Op r = ed.best_rotation(f, k);
+      if (r.valid() && r.gain == 0) neutral.push_back(r);
+    }
+  }
+  for (const QuadEditor::Op& op : neutral) {
+    // Ops are found on the state before any of them; each is applied alone.
+    const size_t m = ed.mark();
+    std::vector<int> touched(ed.face(op.f).begin(), ed.face(op.f).end());
+    if (!op.collapse) touched.insert(touched.end(), ed.face(op.g).begin(), ed.face(op.g).end());
+    ed.apply(op);
+    QuadEditor::Op best;
+    for (int g : faces_near(ed, touched)) {
+      if (!ed.face_alive(g)) continue;
+      const QuadEditor::Op next = ed.best_at(g);
+      if (next.gain > best.gain) best = next;
+    }
+    bool success = false;
+    if (best.valid() && best.gain > 0) {
+      ed.apply(best);
+      ++(best.collapse ? st.collapses : st.rotations);
+      success = true;
+    } else if (depth > 1) {
+      std::vector<int> irregular;
+      for (int v : touched)
+        if (ed.valence(v) != 0 && ed.valence(v) != 4) irregular.push_back(v);
+      std::sort(irregular.begin(), irregular.end());
+      irregular.erase(std::unique(irregular.begin(), irregular.end()), irregular.end());
+      success = !irregular.empty() && look_ahead(ed, irregular, depth - 1, st);
+    }
+    if (success) {
+      ++(op.collapse ? st.collapses : st.rotations);
+      return true;
+    }
+    ed.undo(m);
+  }
+  return false;
+}
+
+}  // namespace
+
+CageSimplifyStats cancel_irregular_vertices(PolyMesh& quads, const QuadSimplifyOptions& options,
+                                            const std::vector<Vec3>* normals,
+                                            std::vector<int>* kept_vertex) {
+  CageSimplifyStats st;
+  QuadEditor ed(quads, normals ? *normals : std::vector<Vec3>(), options.min_corner_sine);
+  st.quads_before = static_cast<int>(quads.n_faces());
+  st.irregular_before = count_irregular(ed);
+  greedy_pass(ed, st.collapses, st.rotations);
+  ed.forget();
+  const int depth = std::max(1, options.depth);
+  for (int round = 0; round < options.rounds; ++round) {
+    int accepted = 0;
+    for (size_t v0 = 0; v0 < ed.num_vertices(); ++v0) {
+      const int val0 = ed.valence(static_cast<int>(v0));
+      if (val0 == 0 || val0 == 4) continue;
+      if (look_ahead(ed, {static_cast<int>(v0)}, depth, st)) ++accepted;
+      ed.forget();
+    }
+    accepted += greedy_pass(ed, st.collapses, st.rotations);
+    ed.forget();
+    if (accepted == 0) break;
+  }
+  // Rebuild with the surviving vertices in their old order.
+  std::vector<int> new_index(ed.num_vertices(), -1), kept;
+  PolyMesh out;
+  for (size_t v = 0; v < ed.num_vertices(); ++v) {
+    if (ed.valence(static_cast<int>(v)) == 0) continue;
+    new_index[v] = static_cast<int>(kept.size());
+    kept.push_back(static_cast<int>(v));
+    out.add_vertex(ed.position(static_cast<int>(v)));
+  }
+  for (size_t f = 0; f < ed.num_faces(); ++f) {
+    if (!ed.face_alive(static_cast<int>(f))) continue;
+    std::vector<VH> vs;
+    for (int v : ed.face(static_cast<int>(f))) vs.emplace_back(new_index[v]);
+    if (!out.add_face(vs).is_valid()) {
+      // Not expected (the operations keep the mesh manifold): keep the input.
+      st = CageSimplifyStats{};
+      st.quads_before = st.quads_after = static_cast<int>(quads.n_faces());
+      QuadEditor again(quads, {}, 0.0);
+      st.irregular_before = st.irregular_after = count_irregular(again);
+      if (kept_vertex) {
+        kept_vertex->resize(quads.n_vertices());
+        std::iota(kept_vertex->begin(), kept_vertex->end(), 0);
+      }
+      return st;
+    }
+  }
+  quads = std::move(out);
+  st.quads_after = static_cast<int>(quads.n_faces());
+  st.irregular_after = count_irregular(ed);
+  if (kept_vertex) *kept_vertex = std::move(kept);
+  return st;
+}
+
+namespace {
+
+// The patches of a quad complex on a quad mesh as a coarse quad mesh: one vertex per node (at
+// its quad-mesh vertex), one face per patch. Returns false when that is not a manifold
+// polygon mesh (a loop arc, two arcs joining the same nodes, a patch that is not 4-sided).
+bool complex_to_mesh(const PolyMesh& quads, const QuadComplex& complex, PolyMesh& out) {
+  out.clear();
+  // Loop arcs and parallel arcs have no place in a polygon mesh (checked here rather than by
+  // add_face, which reports on stderr).
+  std::vector<std::pair<int, int>> ends;
+  for (const auto& arc : complex.arcs) {
+    if (arc.from == arc.to) return false;
+    ends.emplace_back(std::min(arc.from, arc.to), std::max(arc.from, arc.to));
+  }
+  std::sort(ends.begin(), ends.end());
+  if (std::adjacent_find(ends.begin(), ends.end()) != ends.end()) return false;
+  const int n = static_cast<int>(complex.node_vertex.size());
+  for (int v : complex.node_vertex) out.add_vertex(quads.point(VH(v)));
+  // Position of each half-arc in its node's counter-clockwise list.
+  const size_t n_half = 2 * complex.arcs.size();
+  std::vector<int> node_of(n_half, -1), slot(n_half, -1);
+  for (int node = 0; node < n; ++node) {
+    const auto& list = complex.node_half_arcs[node];
+    for (size_t i = 0; i < list.size(); ++i) {
+      node_of[list[i]] = node;
+      slot[list[i]] = static_cast<int>(i);
+    }
+  }
+  for (size_t h = 0; h < n_half; ++h)
+    if (node_of[h] < 0) return false;
+  std::vector<char> used(n_half, 0);
+  for (size_t h0 = 0; h0 < n_half; ++h0) {
+    if (used[h0]) continue;
+    std::vector<VH> corners;
+    size_t h = h0;
+    do {
+      if (used[h] || corners.size() > 4) return false;
+      used[h] = 1;
+      corners.emplace_back(node_of[h]);
+      // The face left of h continues at the other end with the half-arc clockwise before
+      // h's reverse.
+      const size_t back = h ^ 1;
+      const auto& list = complex.node_half_arcs[node_of[back]];
+      h = list[(slot[back] + list.size() - 1) % list.size()];
+    } while (h != h0);
+    if (corners.size() != 4 || !out.add_face(corners).is_valid()) return false;
+  }
+  return true;
+}
+
+// The complex of a coarse quad mesh split into a finer one (split_to_quads keeps the coarse
+// vertices first, all new vertices have valence 4): every coarse vertex is a node, every coarse
+// edge an arc (the straight chain of fine edges between its ends).
+QuadComplex coarse_edge_complex(const PolyMesh& fine, int coarse_vertices, int coarse_faces) {
+  QuadComplex qc;
+  for (int v = 0; v < coarse_vertices; ++v) qc.node_vertex.push_back(v);
+  qc.node_half_arcs.assign(coarse_vertices, {});
+  std::vector<int> half_of(fine.n_halfedges(), -1);  // first fine halfedge -> half-arc
+  for (int v = 0; v < coarse_vertices; ++v) {
+    // Outgoing halfedges counter-clockwise.
+    const auto start = fine.halfedge_handle(VH(v));
+    auto h = start;
+    do {
+      if (half_of[h.idx()] < 0) {
+        QuadComplex::Arc arc;
+        arc.from = v;
+        arc.path.push_back(v);
+        auto g = h;
+        while (true) {
+          const int to = fine.to_vertex_handle(g).idx();
+          arc.path.push_back(to);
+          if (to < coarse_vertices) break;
+          // Straight on through the valence-4 vertex: the opposite edge.
+          const auto back = fine.opposite_halfedge_handle(g);
+          auto next = fine.opposite_halfedge_handle(fine.prev_halfedge_handle(back));
+          next = fine.opposite_halfedge_handle(fine.prev_halfedge_handle(next));
+          g = next;
+        }
+        arc.to = arc.path.back();
+        const int a = static_cast<int>(qc.arcs.size());
+        half_of[h.idx()] = 2 * a;
+        half_of[fine.opposite_halfedge_handle(g).idx()] = 2 * a + 1;
+        qc.arcs.push_back(std::move(arc));
+      }
+      qc.node_half_arcs[v].push_back(half_of[h.idx()]);
+      h = fine.opposite_halfedge_handle(fine.prev_halfedge_handle(h));
+    } while (h != start);
+    qc.valence.push_back(static_cast<int>(qc.node_half_arcs[v].size()));
+    qc.irregular_vertices += qc.valence.back() != 4;
+  }
+  qc.num_patches = coarse_faces;
+  return qc;
+}
+
+}  // namespace
+
+namespace {
+
+struct SimplifiedLayout {
+  Layout layout;
+  PolyMesh fine;        // the split coarse mesh on the surface
+  QuadComplex complex;  // its coarse edges as arcs
+  CageSimplifyStats stats;
+};
+
+// CageOptions::simplify: the complex on the fitted cage as a coarse quad mesh, its irregular
+// vertices cancelled, split back down, smoothed on the surface and transferred.
+// \throw InvalidInputError when the complex is no manifold mesh or the transfer fails.
+SimplifiedLayout simplified_layout(const PolyMesh& cage, const QuadComplex& source,
+                                   const TriMesh& mesh, const CageOptions& options) {
+  PolyMesh coarse;
+  if (!complex_to_mesh(cage, source, coarse))
+    throw InvalidInputError("its patches do not form a manifold quad mesh");
+  std::vector<Vec3> normals;
+  for (int v : source.node_vertex) {
+    const Vec3 n = cage_vertex_normal(cage, VH(v));
+    normals.push_back(n / std::max(1e-12, n.norm()));
+  }
+  SimplifiedLayout out;
+  out.stats = cancel_irregular_vertices(coarse, QuadSimplifyOptions{}, &normals);
+  // Re-embedding alone only loses the cage's shape (its arcs become straight chains).
+  if (out.stats.irregular_after == out.stats.irregular_before)
+    throw InvalidInputError("no irregular node could be cancelled");
+  // Merged nodes sit at midpoints: back onto the surface.
+  CageFitOptions project = options.fit;
+  project.presmoothing = 0;
+  project.iterations = 0;
+  fit_cage(coarse, mesh, project);
+  const int nv = static_cast<int>(coarse.n_vertices());
+  const int nf = static_cast<int>(coarse.n_faces());
+  out.fine = coarse;
+  for (int k = 0; k < std::max(0, options.simplify_splits); ++k) refine_fitted_cage(out.fine, mesh);
+  relax_vertices(out.fine, mesh, std::max(0, options.simplify_relaxation));
+  const int folded = fit_cage(out.fine, mesh, project);
+  out.complex = coarse_edge_complex(out.fine, nv, nf);
+  try {
+    out.layout = transfer_complex(out.fine, out.complex, mesh, options.transfer);
+  } catch (const InvalidInputError& e) {
+    std::string why = e.what();
+    why = why.substr(0, why.find("; --coarsen"));
+    throw InvalidInputError(std::to_string(out.stats.irregular_before) + " -> " +
+                            std::to_string(out.stats.irregular_after) + " irregular nodes, " +
+                            std::to_string(nf) + " patches, " + std::to_string(folded) +
+                            " folded; transfer failed: " + why);
+  }
+  return out;
+}
+
+}  // namespace
+
 CageResult cage_layout(const TriMesh& mesh, const CageOptions& options) {
   MeshReport mesh_report;
   count_topology(mesh, mesh_report);
@@ -596,6 +1213,7 @@ CageResult cage_layout(const TriMesh& mesh, const CageOptions& options) {
     }
     const int folded = fit_cage(cage, mesh, options.fit);
     int chosen = -1, refined = 0;
+    bool simplified = false;
     QuadComplex complex;
     CoarsenStats stats;
     // Splitting adds arcs in all-edges mode (one patch per quad), so it is for complexes only.
@@ -611,6 +1229,25 @@ CageResult cage_layout(const TriMesh& mesh, const CageOptions& options) {
         co.max_width = options.coarsen * result.voxels.grid.h;
         CoarsenStats coarse_stats;
         QuadComplex coarse = coarsen_complex(cage, full, co, &coarse_stats);
+        if (options.simplify && refined == 0 && !simplified) {
+          simplified = true;
+          try {
+            SimplifiedLayout sl = simplified_layout(
+                cage, coarse_stats.chords_collapsed > 0 ? coarse : full, mesh, options);
+            result.layout = std::move(sl.layout);
+            result.simplify = sl.stats;
+            result.simplified = true;
+            complex = std::move(sl.complex);
+            stats = coarse_stats;
+            stats.nodes_after = static_cast<int>(complex.node_vertex.size());
+            stats.arcs_after = static_cast<int>(complex.arcs.size());
+            stats.patches_after = complex.num_patches;
+            cage = std::move(sl.fine);
+            chosen = 0;
+          } catch (const InvalidInputError& e) {
+            failures.push_back(name + ": simplified layout: " + e.what());
+          }
+        }
         if (coarse_stats.chords_collapsed > 0)
           candidates.emplace_back(std::move(coarse), coarse_stats);
       }

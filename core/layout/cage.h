@@ -84,6 +84,49 @@ int fit_cage(PolyMesh& cage, const TriMesh& mesh, const CageFitOptions& options 
 //! \pre is_pure_quad(cage).
 void refine_fitted_cage(PolyMesh& cage, const TriMesh& mesh);
 
+//! What cancel_irregular_vertices did.
+struct CageSimplifyStats {
+  int quads_before = 0, quads_after = 0;
+  int irregular_before = 0, irregular_after = 0;  //!< vertices of valence != 4
+  int collapses = 0, rotations = 0;               //!< operations applied
+};
+
+struct QuadSimplifyOptions {
+  //! Rounds of look-ahead after the greedy pass (0: greedy only), see
+  //! cancel_irregular_vertices.
+  int rounds = 0;
+  //! Neutral operations in a row before the improving one in a look-ahead (>= 1).
+  int depth = 1;
+  //! With surface normals: the smallest sin(corner angle) of a face an operation makes or
+  //! changes (0.5: corners between 30° and 150°).
+  double min_corner_sine = 0.5;
+};
+
+//! Cancels nearby irregular vertices of a closed pure quad mesh (e.g. the valence-3/5 pairs a
+//! voxel staircase leaves about one cell apart) by local operations that keep it a closed
+//! manifold quad mesh of the same genus:
+//! - diagonal collapse of a quad (a, b, c, d): a and c merge at their midpoint (valence
+//!   val(a) + val(c) − 2), b and d lose one edge;
+//! - edge rotation: the edge between two quads turns to another diagonal of their hexagon (its
+//!   ends lose one edge, two opposite hexagon corners gain one).
+//! Every operation keeps all valences >= 3 (at most 8). Greedy pass: operations that lower
+//! Σ (valence − 4)² are applied until there is none. Then, for options.rounds rounds, at each
+//! irregular vertex: an operation that leaves the sum unchanged is kept when, after at most
+//! options.depth − 1 further such operations at the irregular vertices it touched, an
+//! improving one becomes possible nearby (moves a defect towards its partner).
+//! \param normals if given, unit surface normal per vertex: every face an operation makes or
+//!        changes must then turn the normals' way at each corner, with sin(angle) >=
+//!        options.min_corner_sine (a merged vertex takes the mean normal); keeps a coarse mesh
+//!        on a surface unfolded.
+//! \param kept_vertex if given, receives the old index of each vertex of the result (vertices
+//!        are renumbered compactly in their old order; of a merged pair, the one that
+//!        survives).
+//! \pre is_pure_quad(quads), closed and manifold.
+CageSimplifyStats cancel_irregular_vertices(PolyMesh& quads,
+                                            const QuadSimplifyOptions& options = {},
+                                            const std::vector<Vec3>* normals = nullptr,
+                                            std::vector<int>* kept_vertex = nullptr);
+
 struct CageOptions {
   //! Cells along the longest bounding-box axis for the first attempt.
   int resolution = 12;
@@ -109,6 +152,19 @@ struct CageOptions {
   //! staircases (fewer, larger patches). When the coarsened layout cannot be transferred, the
   //! full complex is tried next.
   double coarsen = 1.5;
+  //! Base complex only. Before the transfers of each attempt's unsplit cage: its (coarsened)
+  //! complex becomes a coarse quad mesh (a vertex per node, a face per patch; skipped when that
+  //! is not a manifold mesh, e.g. two arcs join the same nodes); its nearby irregular vertices
+  //! are cancelled (cancel_irregular_vertices, greedy, corners kept within 30°–150°); it is
+  //! projected onto the surface, split simplify_splits times (refine_fitted_cage), smoothed
+  //! simplify_relaxation times (every vertex to its neighbours' mean, projected back onto
+  //! faces facing the same way), and its edges, as straight chains of the split mesh, are
+  //! transferred as the arcs. When no irregular node could be cancelled or that transfer
+  //! fails, the complexes are tried as without simplify. Fewer irregular nodes (fertility at
+  //! resolution 34: 257 -> 139).
+  bool simplify = false;
+  int simplify_splits = 2;      //!< see simplify
+  int simplify_relaxation = 5;  //!< see simplify
   CageFitOptions fit;
   //! Options of the transfer onto the mesh (all_edges and refine are ignored).
   QuadImportOptions transfer;
@@ -117,10 +173,15 @@ struct CageOptions {
 struct CageResult {
   Layout layout;  //!< valid layout on the input mesh (validate_layout passed)
   //! The fitted cage (vertices on the mesh surface) after `refined` splits; its first
-  //! voxels.grid_vertex.size() vertices are the voxel cage's.
+  //! voxels.grid_vertex.size() vertices are the voxel cage's. When the simplified layout was
+  //! used (simplified), the split coarse mesh instead (its first vertices are the nodes).
   PolyMesh cage;
-  QuadComplex complex;   //!< the layout on the cage (after coarsening)
-  CoarsenStats coarsen;  //!< before/after counts (equal without coarsening)
+  QuadComplex complex;      //!< the layout on the cage (after coarsening)
+  CoarsenStats coarsen;     //!< before/after counts (equal without coarsening)
+  bool simplified = false;  //!< the layout is the simplified one (CageOptions::simplify)
+  //! With simplified: the coarse mesh's quads and irregular vertices before/after
+  //! cancel_irregular_vertices.
+  CageSimplifyStats simplify;
   VoxelCageInfo voxels;
   int resolution = 0;                 //!< resolution of the attempt that succeeded
   double shift = 0;                   //!< grid shift (cells) of the attempt that succeeded
