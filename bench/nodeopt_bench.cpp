@@ -9,12 +9,13 @@
 // Times are CPU seconds of the process (CLOCK_PROCESS_CPUTIME_ID: wall time is meaningless
 // on a shared, overloaded machine); run with OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
 // OMP_THREAD_LIMIT=1 so that no spinning helper thread is counted (Debian's CHOLMOD asks for 4
-// OpenMP threads in its supernodal factorization whatever OMP_NUM_THREADS says; only the
-// thread limit caps them). A step's time runs from one observer report to the
-// next. Prints one line per repeat and a summary: the median over repeats of the fresh pipeline
-// (field + parameterization setup and solve), of one parameterization re-solve (assembly +
-// CHOLMOD numeric factorization + back-substitution on the same ParamSolver), of the
-// median descent step, and their ratio; plus the optimizer's work counters.
+// OpenMP threads in its supernodal factorization whatever OMP_NUM_THREADS says); OMP_NUM_THREADS
+// also sets the library's solver thread limit (set_solver_threads), which sizes OpenBLAS's pool. A
+// step's time runs from one observer report to the next. Prints one line per repeat and a summary:
+// the median over repeats of the fresh pipeline (field + parameterization setup and solve), of one
+// parameterization re-solve (assembly + CHOLMOD numeric factorization + back-substitution on the
+// same ParamSolver), of the median descent step, and their ratio; plus the optimizer's work
+// counters.
 #include <time.h>
 
 #include <algorithm>
@@ -24,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "core/base/solver_threads.h"
 #include "core/layout/layout_io.h"
 #include "core/mesh/mesh_io.h"
 #include "core/nodeopt/optimizer.h"
@@ -66,6 +68,11 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: %s MESH LAYOUT [STEPS=10] [REPEATS=3]\n", argv[0]);
     return 2;
   }
+  // The library's own thread limit (core/base/solver_threads.h, default 2) resizes OpenBLAS's
+  // pool whatever OPENBLAS_NUM_THREADS says, and an idle pool thread spins on CPU time: follow
+  // OMP_NUM_THREADS so that one-thread runs count one thread.
+  if (const char* threads = std::getenv("OMP_NUM_THREADS"))
+    if (std::atoi(threads) > 0) qs::set_solver_threads(std::atoi(threads));
   try {
     const qs::TriMesh mesh = qs::load_mesh(argv[1]);
     const qs::Layout layout = qs::load_layout(argv[2], mesh);

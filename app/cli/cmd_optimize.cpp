@@ -77,6 +77,9 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       no.max_steps = o.steps;
       no.gradient = o.gradient == "exact" ? GradientMethod::Exact : GradientMethod::Estimator;
       no.orientation_at_end = !o.no_orientation;
+      // Integer sizes put nodes exactly on shared iso-lines: fresh trial Pipelines there (see
+      // NodeOptOptions::reuse_field).
+      if (o.integer) no.reuse_field = false;
       return optimize_nodes(start_mesh, start_layout, run_options, no, &printer);
     };
     // After a run: its mesh, layout and the options of its final solve.

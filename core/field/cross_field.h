@@ -108,12 +108,17 @@ class CrossFieldSolver {
   //! projected onto the current faces.
   const CrossField& solve(const GeometryCache& geometry);
   //! After the layout changed on the same mesh connectivity (nodes moved to other vertices,
-  //! arcs rerouted): recomputes the period jumps and the clusters' relative rotations, puts
-  //! every constraint back in force (the construction's factorization), redoes the warm start
-  //! (relaxed mode; layout-field mode with its kept reference factorization) and re-solves.
-  //! Clusters that contradict the new layout are dropped as in the constructor (a
-  //! factorization per drop pass, only when more edges mismatch than the constructor's passes
-  //! left). The constraint set (from the construction's geometry) is kept.
+  //! arcs rerouted, vertices relocated): collects the constraints of the current geometry and
+  //! layout as the constructor does (curvature recomputed). When they are on the same faces
+  //! with the same kinds (only directions moved), it recomputes the period jumps and the
+  //! clusters' relative rotations, puts every constraint back in force (the construction's
+  //! factorization), redoes the warm start (relaxed mode; layout-field mode with its kept
+  //! reference factorization) and re-solves; clusters that contradict the new layout are
+  //! dropped as in the constructor (a factorization per drop pass, only when more edges
+  //! mismatch than the constructor's passes left). Otherwise it sets up again as the
+  //! constructor (one numeric factorization with the kept analysis, plus drop passes).
+  //! Either way the field is a fresh construction's at this geometry up to solver round-off
+  //! (on the same-face path, unless a drop pass that the tolerance skips would have helped).
   //! \throw TopologyError as the constructor, InvalidInputError when the mesh size changed.
   const CrossField& update_layout(const TriMesh& mesh, const GeometryCache& geometry,
                                   const Layout& layout, const LayoutTopology& topology);
@@ -125,6 +130,14 @@ class CrossFieldSolver {
   const Eigen::SparseMatrix<double>& matrix() const { return matrix_; }
 
  private:
+  //! Curvature (when enabled; incremental from curvature_cache_) and collect_constraints for
+  //! \p geometry and \p layout.
+  FieldConstraints current_constraints(const TriMesh& mesh, const GeometryCache& geometry,
+                                       const Layout& layout);
+  //! The constructor after the constraints: period jumps, clusters, matrix, factorization
+  //! (analysis reused on the same pattern), warm start, solve and drop passes.
+  void setup(const TriMesh& mesh, const GeometryCache& geometry, const Layout& layout,
+             const LayoutTopology& topology, FieldConstraints constraints);
   Eigen::VectorXd rhs(const GeometryCache& geometry, const std::vector<double>& c) const;
   std::vector<double> constraint_angles(const GeometryCache& geometry) const;
   void factorize(SpdSolver& solver, const Eigen::SparseMatrix<double>& A);  //!< timed, counted
@@ -145,6 +158,9 @@ class CrossFieldSolver {
   int count_mismatches(const GeometryCache& geometry) const;
 
   CrossFieldOptions options_;
+  //! The curvature of the last constraint collection (update_layout recomputes only around
+  //! moved vertices).
+  CurvatureCache curvature_cache_;
   CrossField field_;
   std::vector<int> constraint_at_;       //!< per face: constraint index or -1
   std::vector<char> carrier_;            //!< per face: carries the angle between constraints

@@ -3,6 +3,7 @@
 // (paper §4.2, algorithm.md §2).
 #pragma once
 
+#include <Eigen/Core>
 #include <vector>
 
 #include "core/layout/layout.h"
@@ -31,9 +32,28 @@ struct Curvature {
   int reliable_faces = 0;
 };
 
+//! What compute_curvature keeps for update_curvature: the positions it was computed at and
+//! its per-vertex tensors and areas at every smoothing level (level 0 raw, size `rings`).
+struct CurvatureCache {
+  std::vector<Vec3> points;                          //!< size #V
+  std::vector<std::vector<Eigen::Matrix3d>> tensor;  //!< per level, size #V each
+  std::vector<std::vector<double>> area;             //!< per level, size #V each
+  std::vector<double> magnitude;                     //!< per face: max(|κ1|, |κ2|)
+  Curvature curvature;                               //!< the result
+  CurvatureOptions options;
+};
+
 //! Normal-cycle curvature tensor (Cohen-Steiner & Morvan) per face over a ring neighbourhood.
+//! With \p cache, also fills it for update_curvature.
 Curvature compute_curvature(const TriMesh& mesh, const GeometryCache& geometry,
-                            const CurvatureOptions& options = {});
+                            const CurvatureOptions& options = {}, CurvatureCache* cache = nullptr);
+
+//! compute_curvature after vertices moved (same connectivity, \p geometry updated): only the
+//! tensors and faces within reach of moved vertices are recomputed (the reliable set, which
+//! depends on a global percentile, is redone); bit-identical to compute_curvature. Falls back to
+//! a full computation when \p cache does not match the mesh or the options. Updates \p cache.
+Curvature update_curvature(const TriMesh& mesh, const GeometryCache& geometry,
+                           const CurvatureOptions& options, CurvatureCache& cache);
 
 //! Edges whose dihedral angle (between face normals) exceeds \p sharp_angle_deg, plus the
 //! layout's feature edges. Boundary edges are not included. Size #E flags.

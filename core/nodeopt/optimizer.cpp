@@ -38,7 +38,8 @@ Evaluation evaluate_fresh(const TriMesh& mesh, const Layout& layout, const Pipel
 }
 
 // Nodes moved to other vertices (re-routed layout): a Pipeline that reuses \p previous's field
-// solver (update_layout, no factorization) and geometry; see Pipeline(mesh, layout, previous).
+// solver (update_layout: no analysis, numeric factorizations only for a changed constraint set
+// or a drop pass) and geometry; see Pipeline(mesh, layout, previous).
 Evaluation evaluate_relayout(const Pipeline& previous, const TriMesh& mesh, const Layout& layout,
                              const PipelineOptions& options) {
   Evaluation ev;

@@ -41,15 +41,16 @@ struct NodeOptOptions {
   bool retry_without_switches = true;
   //! A trial in which nodes change their vertex (re-routed arcs), and a hop evaluation,
   //! continues the current Pipeline (Pipeline(mesh, layout, previous)): a copy of its field
-  //! solver re-solved for the new layout with the same constraint set and factorizations.
-  //! false: a fresh Pipeline per such trial (curvature, constraints and every factorization
-  //! redone; slower; its field differs slightly where relocated vertices changed the
-  //! curvature, since a continued field keeps the start geometry's constraints).
-  //! Off by default: on spot (imported onto itself) the continued field lets the descent go
-  //! further (E 1.27 instead of 1.45) into a state with a flipped cone at one node, where the
-  //! orientation constraints are infeasible and 12 fold-overs remain; the fresh path ends with
-  //! none. On the 70K bunny it makes a step about 30 % cheaper (docs/benchmarks.md).
-  bool reuse_field = false;
+  //! solver re-solved for the new layout by CrossFieldSolver::update_layout, which collects the
+  //! constraints of the trial's (relocated) geometry again (curvature updated around moved
+  //! vertices) and keeps the factorizations' analyses, so the field is a fresh Pipeline's up to
+  //! solver round-off (tests/reuse_test.cpp). false: a fresh Pipeline per such trial (curvature,
+  //! constraints, every analysis and factorization redone). On the 70K bunny the continued
+  //! trials give the same 25-step trajectory and E as fresh ones at about 15 % less CPU (the
+  //! constraint set changes in every trial there, so each refactorizes); on spot (imported onto
+  //! itself) both end at E 1.496 with 0 fold-overs.
+  //! `optimize --integer` turns it off (nodes on shared iso-lines, see cmd_optimize.cpp).
+  bool reuse_field = true;
   //! Polish by discrete hops (discrete.h hop_sweep) when the descent ends (no node moves, more
   //! than max_halvings halvings, or the step budget is used up): the descent can stop in a local
   //! optimum of E for the node carried by its current (relocated) vertex, which a hop to a

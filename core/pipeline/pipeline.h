@@ -42,12 +42,11 @@ class Pipeline {
   //! structure). It reuses \p previous's work instead of starting over:
   //! - the geometry continues \p previous's (κ continued, as update_positions);
   //! - the cross field is a copy of \p previous's solver (sharing its factorizations) re-solved
-  //!   for the new layout by CrossFieldSolver::update_layout: new period jumps, every
-  //!   constraint back in force, warm start and drop passes as in a fresh construction, but no
-  //!   curvature and no factorization unless a drop pass needs one. Its constraint set comes
-  //!   from the geometry the field solver was first built on, so θ can differ slightly from a
-  //!   fresh Pipeline's where relocated vertices changed the curvature (equal when the vertex
-  //!   positions are the same).
+  //!   for the new layout by CrossFieldSolver::update_layout: the constraints of this geometry
+  //!   and layout (curvature recomputed), new period jumps, every constraint back in force, warm
+  //!   start and drop passes as in a fresh construction. No factorization unless a drop pass
+  //!   needs one or the constraint set changed (then one numeric factorization with the kept
+  //!   analysis). θ equals a fresh Pipeline's up to solver round-off.
   //! The parameterization solver is built anew. Without a field in \p previous the field is
   //! built as in a fresh Pipeline. \p previous is not changed.
   //! \throw InvalidInputError when the vertex or face count differs.

@@ -1,0 +1,187 @@
+// Reuse of work between node-optimization trials (issue #5): a Pipeline continued from the
+// previous one (Pipeline(mesh, layout, previous)) after nodes switched vertices AND vertices
+// were relocated must give a fresh Pipeline's field at that geometry (the constraint set is
+// collected again from the relocated geometry's curvature).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "core/field/curvature.h"
+#include "core/layout/layout_io.h"
+#include "core/layout/routing.h"
+#include "core/mesh/mesh_io.h"
+#include "core/nodeopt/optimizer.h"
+#include "core/nodeopt/relocation.h"
+#include "core/pipeline/pipeline.h"
+#include "tests/fixtures.h"
+
+namespace qs {
+namespace {
+
+struct Example {
+  TriMesh mesh;
+  Layout layout;
+};
+
+Example ellipsoid_example() {
+  const std::string dir = test::assets_dir() + "/example/";
+  Example e;
+  e.mesh = load_mesh(dir + "ellipsoid.obj");
+  e.layout = load_layout(dir + "ellipsoid.layout.json", e.mesh);
+  return e;
+}
+
+// Moves every unpinned node one ring away (re-routed), as a node optimization trial does.
+Layout moved_layout(const TriMesh& mesh, Layout layout, unsigned seed) {
+  std::mt19937 rng(seed);
+  for (int n = 0; n < static_cast<int>(layout.nodes.size()); ++n) {
+    if (layout.nodes[n].pinned) continue;
+    auto cand = test::ring_vertices(mesh, layout.nodes[n].vertex, 1);
+    std::shuffle(cand.begin(), cand.end(), rng);
+    for (int w : cand) {
+      if (forbidden_relocation_vertices(mesh, layout, n)[w]) continue;
+      if (move_node_and_reroute(mesh, layout, n, w)) break;
+    }
+  }
+  return layout;
+}
+
+// Relocates the vertices within one ring of every node: each moves `fraction` of the way to a
+// random neighbour (as the descent's continuous relocation moves node vertices in the surface).
+TriMesh relocated(const TriMesh& mesh, const Layout& layout, double fraction, unsigned seed) {
+  TriMesh out = mesh;
+  std::mt19937 rng(seed);
+  for (const auto& node : layout.nodes) {
+    for (int v : test::ring_vertices(mesh, node.vertex, 1)) {
+      const auto vh = mesh.vertex_handle(v);
+      std::vector<int> nb;
+      for (auto w : mesh.vv_range(vh)) nb.push_back(w.idx());
+      const int w = nb[std::uniform_int_distribution<int>(0, static_cast<int>(nb.size()) - 1)(rng)];
+      const Vec3 p = mesh.point(vh);
+      out.set_point(vh, p + fraction * (mesh.point(mesh.vertex_handle(w)) - p));
+    }
+  }
+  return out;
+}
+
+double energy(const Pipeline& p, const PipelineOptions& options) {
+  return unweighted_energy(p.mesh(), p.geometry(), p.field()->theta, *p.parameterization(),
+                           options.param);
+}
+
+bool same_constraint_faces(const FieldConstraints& a, const FieldConstraints& b) {
+  return a.face == b.face && a.kind == b.kind;
+}
+
+// Nodes moved one ring and the vertices around them relocated: the continued Pipeline's field
+// is the fresh Pipeline's at the relocated geometry (same constraint faces and directions, same
+// singularities, θ equal modulo quarter turns to solver tolerance, same E and fold-overs),
+// whether the relocation changed the constraint faces or only their directions.
+void check_continued_matches_fresh(const Example& ex) {
+  const PipelineOptions options;
+  Pipeline first(ex.mesh, ex.layout, options);
+  first.compute_field();
+  first.compute_parameterization();
+  int changed_sets = 0, cases = 0;
+  for (double fraction : {0.05, 0.45})
+    for (unsigned seed : {1u, 2u}) {
+      ++cases;
+      const Layout moved = moved_layout(ex.mesh, ex.layout, seed);
+      const TriMesh mesh = relocated(ex.mesh, ex.layout, fraction, seed);
+      Pipeline fresh(mesh, moved, options);
+      fresh.compute_field();
+      fresh.compute_parameterization();
+      Pipeline continued(mesh, moved, first);
+      continued.compute_field();
+      continued.compute_parameterization();
+      const FieldConstraints& cf = fresh.field()->constraints;
+      const FieldConstraints& cc = continued.field()->constraints;
+      changed_sets += !same_constraint_faces(cf, first.field()->constraints);
+      ASSERT_TRUE(same_constraint_faces(cf, cc)) << "fraction " << fraction << " seed " << seed;
+      double worst_dir = 0;
+      for (size_t k = 0; k < cf.direction.size(); ++k)
+        worst_dir = std::max(worst_dir, (cf.direction[k] - cc.direction[k]).norm());
+      EXPECT_LT(worst_dir, 1e-12);
+      const auto sf = fresh.singularities(), sc = continued.singularities();
+      ASSERT_EQ(sf.size(), sc.size()) << "fraction " << fraction << " seed " << seed;
+      for (size_t k = 0; k < sf.size(); ++k) {
+        EXPECT_EQ(sf[k].vertex, sc[k].vertex);
+        EXPECT_EQ(sf[k].quarter_index, sc[k].quarter_index);
+      }
+      const auto& tf = fresh.field()->theta;
+      const auto& tc = continued.field()->theta;
+      double worst = 0;
+      for (size_t f = 0; f < tf.size(); ++f)
+        worst = std::max(worst, std::abs(std::remainder(tf[f] - tc[f], M_PI / 2)));
+      const double Ef = energy(fresh, options), Ec = energy(continued, options);
+      std::printf(
+          "[stat] fraction %.2f seed %u: constraint faces %zu (first %zu, %s), max |dθ| %.3g, "
+          "E %.9g vs fresh %.9g, fold-overs %d vs %d\n",
+          fraction, seed, cf.face.size(), first.field()->constraints.face.size(),
+          same_constraint_faces(cf, first.field()->constraints) ? "same" : "changed", worst, Ec, Ef,
+          continued.parameterization()->foldovers, fresh.parameterization()->foldovers);
+      EXPECT_LT(worst, 1e-7) << "fraction " << fraction << " seed " << seed;
+      EXPECT_NEAR(Ec, Ef, 1e-7 * Ef) << "fraction " << fraction << " seed " << seed;
+      EXPECT_EQ(continued.parameterization()->foldovers, fresh.parameterization()->foldovers);
+    }
+  // The large relocations change the constraint faces (the set-up-again path is exercised).
+  EXPECT_GT(changed_sets, 0) << "no case changed the constraint set: the test is too weak";
+  EXPECT_EQ(cases, 4);
+}
+
+TEST(ReuseField, ContinuedFieldMatchesFreshAtRelocatedGeometry) {
+  check_continued_matches_fresh(ellipsoid_example());
+}
+
+// An anisotropic cube sphere: many curvature constraints, whose faces and directions move with
+// the relocated vertices.
+TEST(ReuseField, ContinuedFieldMatchesFreshWithCurvatureConstraints) {
+  const auto cs = test::cube_sphere(8, Vec3(2.0, 1.0, 0.6));
+  Example ex{cs.mesh, cs.layout};
+  {
+    Pipeline p(ex.mesh, ex.layout);
+    ASSERT_GT(p.compute_field().constraints.count(ConstraintKind::Curvature), 20);
+  }
+  check_continued_matches_fresh(ex);
+}
+
+// update_curvature after a few vertices moved gives exactly compute_curvature at the new
+// positions (the incremental sums follow the same order), and the reliable set changes.
+TEST(ReuseField, IncrementalCurvatureIsBitIdentical) {
+  const auto cs = test::cube_sphere(10, Vec3(2.0, 1.0, 0.6));
+  const GeometryCache g0 = build_geometry(cs.mesh);
+  CurvatureCache cache;
+  const Curvature c0 = compute_curvature(cs.mesh, g0, {}, &cache);
+  ASSERT_GT(c0.reliable_faces, 0);
+  TriMesh mesh = cs.mesh;
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> pick(0, static_cast<int>(mesh.n_vertices()) - 1);
+  int changed_faces = 0;
+  for (int round = 0; round < 3; ++round) {
+    for (int k = 0; k < 12; ++k) {
+      const auto v = mesh.vertex_handle(pick(rng));
+      const auto w = *mesh.vv_range(v).begin();
+      mesh.set_point(
+          v, mesh.point(v) + 0.4 * (mesh.point(w) - mesh.point(v)) + 0.05 * Vec3(1.0, -0.5, 0.25));
+    }
+    const GeometryCache g = build_geometry(mesh);
+    const Curvature fast = update_curvature(mesh, g, {}, cache);
+    const Curvature full = compute_curvature(mesh, g);
+    ASSERT_EQ(fast.k_max, full.k_max) << "round " << round;
+    ASSERT_EQ(fast.k_min, full.k_min);
+    for (size_t f = 0; f < full.dir_max.size(); ++f) ASSERT_EQ(fast.dir_max[f], full.dir_max[f]);
+    ASSERT_EQ(fast.reliable, full.reliable);
+    EXPECT_EQ(fast.reliable_faces, full.reliable_faces);
+    for (size_t f = 0; f < full.k_max.size(); ++f) changed_faces += full.k_max[f] != c0.k_max[f];
+  }
+  EXPECT_GT(changed_faces, 0) << "the moves did not change the curvature";
+  // Unchanged positions: the cached result.
+  const Curvature same = update_curvature(mesh, build_geometry(mesh), {}, cache);
+  EXPECT_EQ(same.k_max, compute_curvature(mesh, build_geometry(mesh)).k_max);
+}
+
+}  // namespace
+}  // namespace qs
