@@ -45,7 +45,7 @@ TEST(SolverThreads, DefaultAndReset) {
   set_solver_threads(3);
   EXPECT_EQ(solver_threads(), 3);
   set_solver_threads(0);
-  EXPECT_EQ(solver_threads(), 2);
+  EXPECT_EQ(solver_threads(), 1);
 }
 
 // With the limit 1, a thread's factorization starts no OpenMP worker and is still right; the

@@ -34,7 +34,7 @@ struct OptimizeOptions {
   //! Curl-reducing sizing field (ParamOptions::sizing); unset: the library default.
   std::optional<bool> sizing;
   double sharp_angle_deg = 35.0;
-  int threads = 2;
+  int threads = 1;  //!< math-library threads (core/base/solver_threads.h)
 };
 
 struct ImportQuadsOptions {

@@ -2,17 +2,18 @@
 
 #include <dlfcn.h>
 
-#include <algorithm>
 #include <atomic>
+#include <cstdlib>
 
 namespace qs {
 
 namespace {
 
-constexpr int kDefaultThreads = 2;
+constexpr int kDefaultThreads = 1;
 
 std::atomic<int> g_threads{kDefaultThreads};
-std::atomic<int> g_version{1};  // bumped by every set_solver_threads
+std::atomic<int> g_version{1};        // bumped by every set_solver_threads
+std::atomic<bool> g_explicit{false};  // set_solver_threads(n > 0) was called
 thread_local int t_applied_version = 0;
 
 // The libraries are linked through CHOLMOD (libgomp, libblas → OpenBLAS on Debian), not by
@@ -34,6 +35,7 @@ void set_openblas_threads(int n) {
 void set_solver_threads(int n) {
   const int threads = n <= 0 ? kDefaultThreads : n;
   g_threads.store(threads);
+  g_explicit.store(n > 0);
   g_version.fetch_add(1);
   set_openblas_threads(threads);
   limit_solver_threads_here();
@@ -59,8 +61,10 @@ void limit_solver_threads_here() {
     if (set_max_active_levels) set_max_active_levels(1);
     if (set_dynamic) set_dynamic(1);
   }
+  // The default leaves an OPENBLAS_NUM_THREADS of the environment alone.
   static std::atomic<bool> blas_applied{false};
-  if (!blas_applied.exchange(true)) set_openblas_threads(threads);
+  if (!blas_applied.exchange(true) && (g_explicit.load() || !std::getenv("OPENBLAS_NUM_THREADS")))
+    set_openblas_threads(threads);
 }
 
 }  // namespace qs
