@@ -27,6 +27,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench/bench_util.h"
 #include "core/base/spd_solver.h"
 #include "core/field/cross_field.h"
 #include "core/field/curvature.h"
@@ -45,17 +46,8 @@ double seconds_since(Clock::time_point t0) {
 
 // CPU seconds of the whole process (all threads): with OMP_NUM_THREADS=1 and
 // OPENBLAS_NUM_THREADS=1 this is the compute cost, insensitive to other load on the machine.
-double cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+using qs::bench::cpu_seconds;
+using qs::bench::median;
 
 std::string cpu_model() {
   std::ifstream in("/proc/cpuinfo");

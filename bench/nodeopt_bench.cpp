@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_util.h"
 #include "core/base/solver_threads.h"
 #include "core/layout/layout_io.h"
 #include "core/mesh/mesh_io.h"
@@ -34,9 +35,7 @@
 namespace {
 
 double cpu_now() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+  return qs::bench::cpu_seconds();
 }
 
 // CPU time between consecutive reports of descent steps.
@@ -55,11 +54,7 @@ struct StepTimer : qs::Observer {
   }
 };
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+using qs::bench::median;
 
 }  // namespace
 

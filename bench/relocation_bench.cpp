@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_util.h"
 #include "core/base/solver_threads.h"
 #include "core/layout/layout_io.h"
 #include "core/layout/perturb.h"
@@ -33,9 +34,7 @@
 namespace {
 
 double cpu_now() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+  return qs::bench::cpu_seconds();
 }
 
 // Records (CPU time since start, E) of every accepted step.

@@ -14,9 +14,11 @@
 #include <set>
 
 #include "core/field/cross_field.h"
+#include "core/layout/layout_io.h"
 #include "core/layout/routing.h"
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_checks.h"
+#include "core/mesh/mesh_io.h"
 #include "core/nodeopt/gradient.h"
 
 namespace qs::test {
@@ -640,6 +642,28 @@ Vec3 frozen_field_difference(const TriMesh& mesh, const GeometryCache& geometry,
     fd += (E[0] - E[1]) / (2 * eps) * dir;
   }
   return fd;
+}
+
+MeshAndLayout ellipsoid_example() {
+  const std::string dir = assets_dir() + "/example/";
+  MeshAndLayout e;
+  e.mesh = load_mesh(dir + "ellipsoid.obj");
+  e.layout = load_layout(dir + "ellipsoid.layout.json", e.mesh);
+  return e;
+}
+
+FieldGap field_gap(const Pipeline& a, const Pipeline& b) {
+  FieldGap gap;
+  const auto sa = a.singularities(), sb = b.singularities();
+  gap.same_singularities = sa.size() == sb.size();
+  for (size_t k = 0; gap.same_singularities && k < sa.size(); ++k)
+    gap.same_singularities =
+        sa[k].vertex == sb[k].vertex && sa[k].quarter_index == sb[k].quarter_index;
+  const auto& ta = a.field()->theta;
+  const auto& tb = b.field()->theta;
+  for (size_t f = 0; f < ta.size() && f < tb.size(); ++f)
+    gap.max_theta = std::max(gap.max_theta, std::abs(std::remainder(ta[f] - tb[f], M_PI / 2)));
+  return gap;
 }
 
 }  // namespace qs::test

@@ -10,6 +10,7 @@
 #include "core/layout/layout.h"
 #include "core/mesh/geometry.h"
 #include "core/mesh/mesh.h"
+#include "core/pipeline/pipeline.h"
 
 namespace qs::test {
 
@@ -155,5 +156,15 @@ using MovedEnergy =
 Vec3 frozen_field_difference(const TriMesh& mesh, const GeometryCache& geometry,
                              const std::vector<double>& theta, int v, double eps,
                              const MovedEnergy& energy);
+
+//! The bundled example (assets/example/ellipsoid.obj with the displaced sketch layout).
+MeshAndLayout ellipsoid_example();
+
+//! How far the fields of two Pipelines on the same mesh are apart (both computed).
+struct FieldGap {
+  bool same_singularities = false;  //!< same vertices and quarter indices, same order
+  double max_theta = 0;  //!< max over faces of |θ_a − θ_b| modulo quarter turns (rad)
+};
+FieldGap field_gap(const Pipeline& a, const Pipeline& b);
 
 }  // namespace qs::test

@@ -121,18 +121,8 @@ TEST(SpdSolverReuse, OrderingHintGivesTheSameSolution) {
   EXPECT_LT((B * small.solve(b) - b).norm(), 1e-10 * b.norm());
 }
 
-struct Example {
-  TriMesh mesh;
-  Layout layout;
-};
-
-Example ellipsoid_example() {
-  const std::string dir = test::assets_dir() + "/example/";
-  Example e;
-  e.mesh = load_mesh(dir + "ellipsoid.obj");
-  e.layout = load_layout(dir + "ellipsoid.layout.json", e.mesh);
-  return e;
-}
+using Example = test::MeshAndLayout;
+using test::ellipsoid_example;
 
 // Moves every unpinned node `rings` rings away (re-routed), as a node optimization trial does.
 Layout moved_layout(const TriMesh& mesh, Layout layout, int rings, unsigned seed) {
@@ -206,19 +196,10 @@ TEST(Relayout, MovedNodesGiveTheFreshFieldTopology) {
     Pipeline continued(ex.mesh, moved, first);
     continued.compute_field();
     continued.compute_parameterization();
-    // Same singularities (vertex and index).
-    const auto sf = fresh.singularities(), sc = continued.singularities();
-    ASSERT_EQ(sf.size(), sc.size()) << "seed " << seed;
-    for (size_t k = 0; k < sf.size(); ++k) {
-      EXPECT_EQ(sf[k].vertex, sc[k].vertex);
-      EXPECT_EQ(sf[k].quarter_index, sc[k].quarter_index);
-    }
     // θ equal modulo quarter turns (the constraint set is the first geometry's, equal here).
-    const auto& tf = fresh.field()->theta;
-    const auto& tc = continued.field()->theta;
-    double worst = 0;
-    for (size_t f = 0; f < tf.size(); ++f)
-      worst = std::max(worst, std::abs(std::remainder(tf[f] - tc[f], M_PI / 2)));
+    const test::FieldGap gap = test::field_gap(fresh, continued);
+    ASSERT_TRUE(gap.same_singularities) << "seed " << seed;
+    const double worst = gap.max_theta;
     const double Ef = energy(fresh, options), Ec = energy(continued, options);
     std::printf(
         "[stat] relayout seed %u: %d nodes switched, max |dθ| %.3g rad, E %.9g vs fresh "

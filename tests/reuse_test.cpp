@@ -21,18 +21,8 @@
 namespace qs {
 namespace {
 
-struct Example {
-  TriMesh mesh;
-  Layout layout;
-};
-
-Example ellipsoid_example() {
-  const std::string dir = test::assets_dir() + "/example/";
-  Example e;
-  e.mesh = load_mesh(dir + "ellipsoid.obj");
-  e.layout = load_layout(dir + "ellipsoid.layout.json", e.mesh);
-  return e;
-}
+using Example = test::MeshAndLayout;
+using test::ellipsoid_example;
 
 // Moves every unpinned node one ring away (re-routed), as a node optimization trial does.
 Layout moved_layout(const TriMesh& mesh, Layout layout, unsigned seed) {
@@ -105,17 +95,9 @@ void check_continued_matches_fresh(const Example& ex) {
       for (size_t k = 0; k < cf.direction.size(); ++k)
         worst_dir = std::max(worst_dir, (cf.direction[k] - cc.direction[k]).norm());
       EXPECT_LT(worst_dir, 1e-12);
-      const auto sf = fresh.singularities(), sc = continued.singularities();
-      ASSERT_EQ(sf.size(), sc.size()) << "fraction " << fraction << " seed " << seed;
-      for (size_t k = 0; k < sf.size(); ++k) {
-        EXPECT_EQ(sf[k].vertex, sc[k].vertex);
-        EXPECT_EQ(sf[k].quarter_index, sc[k].quarter_index);
-      }
-      const auto& tf = fresh.field()->theta;
-      const auto& tc = continued.field()->theta;
-      double worst = 0;
-      for (size_t f = 0; f < tf.size(); ++f)
-        worst = std::max(worst, std::abs(std::remainder(tf[f] - tc[f], M_PI / 2)));
+      const test::FieldGap gap = test::field_gap(fresh, continued);
+      ASSERT_TRUE(gap.same_singularities) << "fraction " << fraction << " seed " << seed;
+      const double worst = gap.max_theta;
       const double Ef = energy(fresh, options), Ec = energy(continued, options);
       std::printf(
           "[stat] fraction %.2f seed %u: constraint faces %zu (first %zu, %s), max |dθ| %.3g, "
