@@ -4,7 +4,10 @@
 // (relocate_nodes_discrete: every candidate vertex a full solve). Also the CPU time at which the
 // continuous run first reaches the discrete run's final E. Not a test.
 //
-//   qs_relocation_bench [--rings K] [--seeds N] [--max-steps S] [--case NAME]
+//   qs_relocation_bench [--rings K] [--seeds N] [--max-steps S] [--case NAME] [--hop-all]
+//
+// --hop-all: the continuous run's hop polish tries every neighbour of every node (no offset,
+// direction or work limit), an experiment against the defaults.
 //
 // Cases are built in process (tests/fixtures.cpp): the bundled ellipsoid sketch
 // (assets/example), a cube layout on an ellipsoid (cube_sphere(12), radii 1.3 / 1 / 0.75), the
@@ -63,9 +66,16 @@ struct Case {
 
 int main(int argc, char** argv) {
   int rings = -1, seeds = 2, max_steps = 25;
+  bool hop_all = false;  // the hop polish tries every neighbour of every node
   std::string only;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--rings"))
+  for (int i = 1; i < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--hop-all")) {
+      hop_all = true;
+      --i;
+    } else if (i + 1 >= argc) {
+      std::fprintf(stderr, "qs_relocation_bench: %s needs a value\n", argv[i]);
+      return 2;
+    } else if (!std::strcmp(argv[i], "--rings"))
       rings = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--seeds"))
       seeds = std::atoi(argv[i + 1]);
@@ -76,7 +86,7 @@ int main(int argc, char** argv) {
     else {
       std::fprintf(stderr,
                    "usage: qs_relocation_bench [--rings K] [--seeds N] [--max-steps S] "
-                   "[--case NAME]\n");
+                   "[--case NAME] [--hop-all]\n");
       return 2;
     }
   }
@@ -124,6 +134,12 @@ int main(int argc, char** argv) {
         const qs::PipelineOptions options;
         qs::NodeOptOptions no;
         no.max_steps = max_steps;
+        if (hop_all) {
+          no.hop_min_offset = 0;
+          no.hop_candidates = 0;
+          no.hop_min_cos = -1;
+          no.hop_max_evaluations = 1 << 20;
+        }
         Trace cont;
         cont.start = cpu_now();
         const qs::NodeOptResult rc = qs::optimize_nodes(c.mesh, start, options, no, &cont);
