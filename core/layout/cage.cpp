@@ -18,6 +18,24 @@ namespace {
 
 using VH = OpenMesh::VertexHandle;
 
+// Mean edge length of a polygon mesh (0 without edges).
+double mean_edge_length(const PolyMesh& m) {
+  double sum = 0;
+  for (const auto e : m.edges()) sum += m.calc_edge_length(e);
+  return sum / std::max<size_t>(1, m.n_edges());
+}
+
+// Mean position of v's neighbours (v itself when it has none).
+Vec3 neighbour_mean(const PolyMesh& m, VH v) {
+  Vec3 sum(0, 0, 0);
+  int count = 0;
+  for (const auto w : m.vv_range(v)) {
+    sum += m.point(w);
+    ++count;
+  }
+  return count ? sum / count : m.point(v);
+}
+
 // good_block()[mask]: the 2×2×2 cell block around a grid vertex, bit dx + 2·dy + 4·dz set for
 // an occupied cell, gives a manifold surface at the vertex: occupied and empty cells are each
 // face-connected inside the block (the boundary curve on the vertex's link sphere is then a
@@ -469,9 +487,7 @@ Vec3 cage_vertex_normal(const PolyMesh& cage, VH v) {
 void refine_fitted_cage(PolyMesh& cage, const TriMesh& mesh) {
   const size_t old_vertices = cage.n_vertices();
   if (old_vertices == 0) return;
-  double mean_edge = 0;
-  for (const auto e : cage.edges()) mean_edge += cage.calc_edge_length(e);
-  mean_edge /= std::max<size_t>(1, cage.n_edges());
+  const double mean_edge = mean_edge_length(cage);
   cage = split_to_quads(cage);
   SidedProjector projector(mesh, 0.5 * mean_edge);
   std::vector<Vec3> normal(cage.n_vertices());
@@ -488,21 +504,11 @@ namespace {
 // faces facing the same way as the quad mesh at the vertex.
 void relax_vertices(PolyMesh& quads, const TriMesh& mesh, int iterations) {
   if (iterations <= 0 || quads.n_vertices() == 0) return;
-  double mean_edge = 0;
-  for (const auto e : quads.edges()) mean_edge += quads.calc_edge_length(e);
-  mean_edge /= std::max<size_t>(1, quads.n_edges());
+  const double mean_edge = mean_edge_length(quads);
   SidedProjector projector(mesh, mean_edge);
   std::vector<Vec3> next(quads.n_vertices());
   for (int it = 0; it < iterations; ++it) {
-    for (const auto v : quads.vertices()) {
-      Vec3 sum(0, 0, 0);
-      int count = 0;
-      for (const auto w : quads.vv_range(v)) {
-        sum += quads.point(w);
-        ++count;
-      }
-      next[v.idx()] = count ? sum / count : quads.point(v);
-    }
+    for (const auto v : quads.vertices()) next[v.idx()] = neighbour_mean(quads, v);
     for (const auto v : quads.vertices()) {
       const Vec3 n = cage_vertex_normal(quads, v);
       quads.set_point(v, projector.project(next[v.idx()], n, 3.0 * mean_edge).point);
@@ -515,25 +521,14 @@ void relax_vertices(PolyMesh& quads, const TriMesh& mesh, int iterations) {
 int fit_cage(PolyMesh& cage, const TriMesh& mesh, const CageFitOptions& options) {
   const size_t nv = cage.n_vertices();
   if (nv == 0) return 0;
-  double mean_edge = 0;
-  for (const auto e : cage.edges()) mean_edge += cage.calc_edge_length(e);
-  mean_edge /= std::max<size_t>(1, cage.n_edges());
+  const double mean_edge = mean_edge_length(cage);
   SidedProjector projector(mesh, mean_edge);
   std::vector<Vec3> cage_normal(nv), next(nv);
   for (const auto v : cage.vertices()) cage_normal[v.idx()] = cage_vertex_normal(cage, v);
   std::vector<int> face(nv, -1);
-  auto neighbour_mean = [&](VH v) {
-    Vec3 sum(0, 0, 0);
-    int count = 0;
-    for (const auto w : cage.vv_range(v)) {
-      sum += cage.point(w);
-      ++count;
-    }
-    return count ? sum / count : cage.point(v);
-  };
   for (int it = 0; it < options.presmoothing; ++it) {
     for (const auto v : cage.vertices()) {
-      next[v.idx()] = cage.point(v) + options.step * (neighbour_mean(v) - cage.point(v));
+      next[v.idx()] = cage.point(v) + options.step * (neighbour_mean(cage, v) - cage.point(v));
     }
     for (const auto v : cage.vertices()) cage.set_point(v, next[v.idx()]);
   }
@@ -545,9 +540,7 @@ int fit_cage(PolyMesh& cage, const TriMesh& mesh, const CageFitOptions& options)
   }
   // Tangential spring relaxation: every cage edge pulls/pushes towards the mean edge length,
   // every quad diagonal towards √2 times it (keeps quads from collapsing onto a line).
-  double rest = 0;
-  for (const auto e : cage.edges()) rest += cage.calc_edge_length(e);
-  rest /= std::max<size_t>(1, cage.n_edges());
+  const double rest = mean_edge_length(cage);
   auto spring = [&](const Vec3& from, const Vec3& to, double length) {
     const Vec3 d = to - from;
     const double l = d.norm();
