@@ -116,10 +116,10 @@ int main(int argc, char** argv) {
       std::printf(
           "repeat %d: fresh pipeline %.3f s, param re-solve %.3f s, median step %.3f s "
           "(%.1fx), optimize %.3f s, steps %d (accepted %d), E %.6g -> %.6g, fresh pipelines "
-          "%d, relayouts %d, reused solves %d, gradient reuses %d\n",
+          "%d, relayouts %d, reused solves %d, gradient reuses %d, tabu steps %d\n",
           rep, fresh.back(), resolve.back(), step.back(), ratio.back(), total.back(), r.steps,
           r.accepted, r.E_init, r.E_final, stats.fresh_pipelines, stats.relayouts,
-          stats.reused_solves, stats.gradient_reuses);
+          stats.reused_solves, stats.gradient_reuses, stats.tabu_steps);
     }
     std::printf(
         "median: faces %zu, nodes %zu, fresh pipeline %.3f s, param re-solve %.3f s, median "

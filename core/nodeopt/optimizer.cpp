@@ -181,7 +181,22 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
   // one (α reset) with at least hop_descent_steps more.
   int step_budget = no.max_steps;
   std::unique_ptr<State> pre_polish;  // the state before the first kept hop
+  // The accepted state with the fewest fold-overs (equal: the later, lower E), kept while the
+  // current state has more: the second fallback of the fold-over removal.
+  std::unique_ptr<State> fewest_folds;
+  int fewest_folds_count = current.foldovers;
+  auto note_fold_count = [&](const State& before, int after_folds) {
+    if (after_folds <= fewest_folds_count) {  // the new state is the best (equal: lower E)
+      fewest_folds.reset();
+      fewest_folds_count = after_folds;
+    } else if (!fewest_folds) {  // leaving the best state
+      fewest_folds = std::make_unique<State>(before);
+    }
+  };
   int phase_halvings = 0;
+  // Per movable node: the vertex it switched to in the last trial rejected at the current α, or
+  // -1 (switch_tabu); and the targets of the trial being built.
+  std::vector<int> rejected_target(movable.size(), -1), target;
   // Hop sweep (discrete.h): nodes relocated far off their vertex try the neighbours in that
   // direction. Returns true when a node hopped (state and current updated).
   auto hop_round = [&]() {
@@ -233,6 +248,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
       Evaluation next = evaluate_switched(hopped.mesh, hopped.layout);
       if (next.E <= current.E) {  // equal to h.E: the same deterministic solve
         if (!pre_polish) pre_polish = std::make_unique<State>(state);
+        note_fold_count(state, next.foldovers);
         state = std::move(hopped);
         current = std::move(next);
         current_solved = true;
@@ -260,6 +276,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     if (!no.hop_polish || result.hop_rounds >= no.max_hop_rounds || !hop_round()) return false;
     alpha = no.alpha;
     phase_halvings = 0;
+    std::fill(rejected_target.begin(), rejected_target.end(), -1);
     step_budget = std::max(step_budget, result.steps + no.hop_descent_steps);
     return true;
   };
@@ -299,6 +316,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
                            std::vector<char>& switched) {
       trial = state;
       switched.assign(movable.size(), 0);
+      target.assign(movable.size(), -1);
       int moved = 0;
       // Arc and node obstacles of the trial layout, kept up to date by each re-routing.
       LayoutObstacles obstacles = make_layout_obstacles(trial.mesh, trial.layout);
@@ -328,6 +346,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
           trial.mesh.set_point(trial.mesh.vertex_handle(v),
                                original.point(original.vertex_handle(v)));
           switched[i] = 1;
+          target[i] = w;
         }
         trial.mesh.set_point(trial.mesh.vertex_handle(w), tr.end_position);
         trial.anchor[n] = tr.end;
@@ -358,6 +377,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     State trial;
     std::vector<char> switched;
     int moved = build_trial(std::vector<char>(movable.size(), 0), trial, switched);
+    const std::vector<int> first_target = target;
     ++result.steps;
     StepReport r;
     r.step = result.steps + result.hop_rounds;
@@ -376,7 +396,20 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
       break;
     }
     Evaluation next;
-    bool ok = try_evaluate(trial, switched, next);
+    // Mostly the switches of a trial rejected at this α: rejected again without a solve, the
+    // retry without switches follows (switch_tabu).
+    int n_switched = 0, n_repeated = 0;
+    for (size_t i = 0; i < movable.size(); ++i) {
+      n_switched += switched[i];
+      n_repeated += switched[i] && first_target[i] == rejected_target[i];
+    }
+    const bool repeated =
+        no.switch_tabu && n_switched > 0 && n_repeated >= no.switch_tabu_overlap * n_switched;
+    counters.tabu_steps += repeated;
+    bool ok = !repeated && try_evaluate(trial, switched, next);
+    if (!repeated && std::find(switched.begin(), switched.end(), 1) != switched.end())
+      rejected_target =
+          ok && next.E <= current.E ? std::vector<int>(movable.size(), -1) : first_target;
     // A node that changed its vertex can raise E discontinuously: retry once with those nodes
     // kept on their vertices before halving α.
     if (no.retry_without_switches && !(ok && next.E <= current.E) &&
@@ -396,6 +429,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     r.E = ok ? next.E : current.E;
     r.foldovers = ok ? next.foldovers : current.foldovers;
     if (r.accepted) {
+      note_fold_count(state, next.foldovers);
       state = std::move(trial);
       current = std::move(next);
       current_solved = true;
@@ -405,6 +439,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
       alpha *= 0.5;
       ++result.halvings;
       ++phase_halvings;
+      std::fill(rejected_target.begin(), rejected_target.end(), -1);
     }
     r.time_s = seconds_since(t_step);
     r.node_positions = node_positions(state.mesh, state.layout);
@@ -490,19 +525,21 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     }
   };
   finish(state, current, result);
-  // The polish (hops, and the descent after them) lowers E but can end where the fold-over
-  // removal fails although it succeeds at the state before the first hop: then that result is
-  // taken (fewer fold-overs; equal: lower final E).
-  if (result.foldovers_final > 0 && pre_polish) {
+  // The descent and the polish lower E but can end where the fold-over removal fails although
+  // it succeeds at an earlier state: the state before the first hop, then the accepted state
+  // with the fewest fold-overs, are tried; a result with fewer fold-overs (equal: lower final
+  // E) is taken.
+  auto try_earlier = [&](std::unique_ptr<State>& earlier, bool& flag) {
+    if (result.foldovers_final == 0 || !earlier) return;
     check_cancel(observer);
-    Evaluation ev = evaluate_fresh(pre_polish->mesh, pre_polish->layout, options, false);
+    Evaluation ev = evaluate_fresh(earlier->mesh, earlier->layout, options, false);
     ++counters.fresh_pipelines;
     NodeOptResult alt;
-    finish(*pre_polish, ev, alt);
+    finish(*earlier, ev, alt);
     result.reports.insert(result.reports.end(), alt.reports.begin(), alt.reports.end());
     if (alt.foldovers_final < result.foldovers_final ||
         (alt.foldovers_final == result.foldovers_final && alt.E_final < result.E_final)) {
-      state = std::move(*pre_polish);
+      state = std::move(*earlier);
       result.pipeline = alt.pipeline;
       result.descent_pipeline = alt.descent_pipeline;
       result.E_descent = alt.E_descent;
@@ -514,9 +551,14 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
       result.orientation = alt.orientation;
       result.face_weights = alt.face_weights;
       result.stiffening_iterations = alt.stiffening_iterations;
-      result.polish_reverted = true;
+      flag = true;
     }
-  }
+    earlier.reset();
+  };
+  if (!no.orientation_at_end && !no.stiffen_at_end) pre_polish.reset(), fewest_folds.reset();
+  try_earlier(pre_polish, result.polish_reverted);
+  if (fewest_folds && fewest_folds_count < result.foldovers_descent)
+    try_earlier(fewest_folds, result.fewest_foldovers_reverted);
   if (stats) *stats = counters;
   result.mesh = std::move(state.mesh);
   result.layout = std::move(state.layout);
