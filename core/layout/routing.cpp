@@ -42,11 +42,29 @@ std::vector<int> dijkstra(const TriMesh& mesh, int source, const RoutingObstacle
                           const std::function<bool(int)>& is_target) {
   if (!valid_vertex(mesh, source)) return {};
   const double inf = std::numeric_limits<double>::infinity();
-  std::vector<double> dist(mesh.n_vertices(), inf);
-  std::vector<int> parent(mesh.n_vertices(), -1);
+  // Per-thread distances and parents, reset only where a search wrote: re-routing a node runs
+  // thousands of short searches per descent step on a 70K-face mesh, and filling two
+  // #V-sized arrays per search cost more than the searches.
+  struct Workspace {
+    std::vector<double> dist;
+    std::vector<int> parent, touched;
+  };
+  thread_local Workspace ws;
+  const size_t nv = mesh.n_vertices();
+  if (ws.dist.size() < nv) {
+    ws.dist.assign(nv, inf);
+    ws.parent.assign(nv, -1);
+  }
+  std::vector<double>& dist = ws.dist;
+  std::vector<int>& parent = ws.parent;
+  auto set = [&](int v, double d, int p) {
+    if (dist[v] == inf) ws.touched.push_back(v);
+    dist[v] = d;
+    parent[v] = p;
+  };
   using Entry = std::pair<double, int>;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
-  dist[source] = 0.0;
+  set(source, 0.0, -1);
   queue.emplace(0.0, source);
   int found = -1;
   while (!queue.empty()) {
@@ -64,16 +82,19 @@ std::vector<int> dijkstra(const TriMesh& mesh, int source, const RoutingObstacle
       if (is_set(obstacles.vertex_blocked, w) && !is_target(w)) continue;
       const double nd = d + (mesh.point(mesh.to_vertex_handle(heh)) - mesh.point(vh)).norm();
       if (nd < dist[w]) {
-        dist[w] = nd;
-        parent[w] = v;
+        set(w, nd, v);
         queue.emplace(nd, w);
       }
     }
   }
-  if (found < 0) return {};
   std::vector<int> path;
   for (int v = found; v >= 0; v = parent[v]) path.push_back(v);
   std::reverse(path.begin(), path.end());
+  for (int v : ws.touched) {
+    dist[v] = inf;
+    parent[v] = -1;
+  }
+  ws.touched.clear();
   return path;
 }
 

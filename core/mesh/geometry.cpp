@@ -38,6 +38,69 @@ Vec3 GeometryCache::direction_in_face(int f, double phi) const {
 
 namespace {
 
+// Normal, area, frame and corner angles of face f.
+void compute_face(const TriMesh& mesh, GeometryCache& g, int f) {
+  const auto& fv = g.face_vertices[f];
+  const Vec3 p[3] = {mesh.point(mesh.vertex_handle(fv[0])), mesh.point(mesh.vertex_handle(fv[1])),
+                     mesh.point(mesh.vertex_handle(fv[2]))};
+  Vec3 n = (p[1] - p[0]) % (p[2] - p[0]);
+  const double len = n.norm();
+  g.face_area[f] = 0.5 * len;
+  g.face_normal[f] = len > 0 ? n / len : Vec3(0, 0, 1);
+  Vec3 r = p[1] - p[0];
+  const double rl = r.norm();
+  r = rl > 0 ? r / rl : Vec3(1, 0, 0);
+  const double off = g.frame_offset[f];
+  g.face_frame[f] = off == 0.0 ? r : std::cos(off) * r + std::sin(off) * (g.face_normal[f] % r);
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 a = p[(k + 1) % 3] - p[k], b = p[(k + 2) % 3] - p[k];
+    g.corner_angle[3 * f + k] = std::atan2((a % b).norm(), a | b);
+  }
+}
+
+// Length and κ of edge e (κ continued from \p old_kappa when given).
+void compute_edge(const TriMesh& mesh, GeometryCache& g, int e, const double* old_kappa) {
+  const auto [a, b] = g.edge_vertices[e];
+  const Vec3 t = mesh.point(mesh.vertex_handle(b)) - mesh.point(mesh.vertex_handle(a));
+  g.edge_length[e] = t.norm();
+  // κ_ij = α_i − α_j with α_f the angle from the edge direction t = x_b − x_a to r_f.
+  const int i = g.edge_face_i[e], j = g.edge_face_j[e];
+  if (i < 0 || j < 0) {
+    g.kappa[e] = 0.0;
+    return;
+  }
+  const double alpha_i = -g.angle_in_face(i, t);
+  const double alpha_j = -g.angle_in_face(j, t);
+  const double k = wrap_angle(alpha_i - alpha_j);
+  g.kappa[e] = old_kappa ? *old_kappa + wrap_angle(k - *old_kappa) : k;
+}
+
+// Angle defect of v from its faces' corner angles, summed in increasing face order (as the
+// full computation accumulates them).
+void compute_defect(GeometryCache& g, int v) {
+  double sum = 0.0;
+  for (int i = g.vertex_face_offset[v]; i < g.vertex_face_offset[v + 1]; ++i) {
+    const int f = g.vertex_faces[i];
+    const auto& fv = g.face_vertices[f];
+    for (int k = 0; k < 3; ++k)
+      if (fv[k] == v) sum += g.corner_angle[3 * f + k];
+  }
+  g.angle_defect[v] = (g.vertex_on_boundary[v] ? M_PI : 2 * M_PI) - sum;
+}
+
+// Bounding box diagonal and mean edge length from positions and edge_length.
+void compute_totals(const TriMesh& mesh, GeometryCache& g) {
+  Vec3 lo(1e300, 1e300, 1e300), hi(-1e300, -1e300, -1e300);
+  for (auto v : mesh.vertices()) {
+    lo.minimize(mesh.point(v));
+    hi.maximize(mesh.point(v));
+  }
+  g.bbox_diagonal = g.n_vertices ? (hi - lo).norm() : 0.0;
+  double length_sum = 0;
+  for (double l : g.edge_length) length_sum += l;
+  g.mean_edge_length = g.n_edges ? length_sum / g.n_edges : 0.0;
+}
+
 void compute_geometry(const TriMesh& mesh, GeometryCache& g, bool continue_kappa) {
   const int nf = g.n_faces;
   g.face_normal.resize(nf);
@@ -45,53 +108,21 @@ void compute_geometry(const TriMesh& mesh, GeometryCache& g, bool continue_kappa
   g.face_area.resize(nf);
   g.corner_angle.resize(3 * nf);
   g.angle_defect.assign(g.n_vertices, 0.0);
-  Vec3 lo(1e300, 1e300, 1e300), hi(-1e300, -1e300, -1e300);
-  for (auto v : mesh.vertices()) {
-    lo.minimize(mesh.point(v));
-    hi.maximize(mesh.point(v));
-  }
-  g.bbox_diagonal = g.n_vertices ? (hi - lo).norm() : 0.0;
   std::vector<double> angle_sum(g.n_vertices, 0.0);
   for (int f = 0; f < nf; ++f) {
-    const auto& fv = g.face_vertices[f];
-    const Vec3 p[3] = {mesh.point(mesh.vertex_handle(fv[0])), mesh.point(mesh.vertex_handle(fv[1])),
-                       mesh.point(mesh.vertex_handle(fv[2]))};
-    Vec3 n = (p[1] - p[0]) % (p[2] - p[0]);
-    const double len = n.norm();
-    g.face_area[f] = 0.5 * len;
-    g.face_normal[f] = len > 0 ? n / len : Vec3(0, 0, 1);
-    Vec3 r = p[1] - p[0];
-    const double rl = r.norm();
-    r = rl > 0 ? r / rl : Vec3(1, 0, 0);
-    const double off = g.frame_offset[f];
-    g.face_frame[f] = off == 0.0 ? r : std::cos(off) * r + std::sin(off) * (g.face_normal[f] % r);
-    for (int k = 0; k < 3; ++k) {
-      const Vec3 a = p[(k + 1) % 3] - p[k], b = p[(k + 2) % 3] - p[k];
-      const double ang = std::atan2((a % b).norm(), a | b);
-      g.corner_angle[3 * f + k] = ang;
-      angle_sum[fv[k]] += ang;
-    }
+    compute_face(mesh, g, f);
+    for (int k = 0; k < 3; ++k) angle_sum[g.face_vertices[f][k]] += g.corner_angle[3 * f + k];
   }
   for (int v = 0; v < g.n_vertices; ++v)
     g.angle_defect[v] = (g.vertex_on_boundary[v] ? M_PI : 2 * M_PI) - angle_sum[v];
-
-  // κ_ij = α_i − α_j with α_f the angle from the edge direction t = x_b − x_a to r_f.
   std::vector<double> old;
   if (continue_kappa) old = g.kappa;
   g.kappa.assign(g.n_edges, 0.0);
-  double length_sum = 0;
-  for (int e = 0; e < g.n_edges; ++e) {
-    const auto [a, b] = g.edge_vertices[e];
-    const Vec3 t = mesh.point(mesh.vertex_handle(b)) - mesh.point(mesh.vertex_handle(a));
-    length_sum += t.norm();
-    const int i = g.edge_face_i[e], j = g.edge_face_j[e];
-    if (i < 0 || j < 0) continue;
-    const double alpha_i = -g.angle_in_face(i, t);
-    const double alpha_j = -g.angle_in_face(j, t);
-    const double k = wrap_angle(alpha_i - alpha_j);
-    g.kappa[e] = continue_kappa ? old[e] + wrap_angle(k - old[e]) : k;
-  }
-  g.mean_edge_length = g.n_edges ? length_sum / g.n_edges : 0.0;
+  g.edge_length.assign(g.n_edges, 0.0);
+  for (int e = 0; e < g.n_edges; ++e) compute_edge(mesh, g, e, continue_kappa ? &old[e] : nullptr);
+  compute_totals(mesh, g);
+  g.positions.resize(g.n_vertices);
+  for (auto v : mesh.vertices()) g.positions[v.idx()] = mesh.point(v);
 }
 
 }  // namespace
@@ -119,6 +150,21 @@ GeometryCache build_geometry(const TriMesh& mesh) {
     g.edge_face_i[e.idx()] = fi.is_valid() ? fi.idx() : -1;
     g.edge_face_j[e.idx()] = fj.is_valid() ? fj.idx() : -1;
   }
+  g.face_edges.resize(g.n_faces);
+  for (auto f : mesh.faces()) {
+    int k = 0;
+    for (auto e : mesh.fe_range(f)) g.face_edges[f.idx()][k++] = e.idx();
+  }
+  g.vertex_face_offset.assign(g.n_vertices + 1, 0);
+  for (const auto& fv : g.face_vertices)
+    for (int v : fv) ++g.vertex_face_offset[v + 1];
+  for (int v = 0; v < g.n_vertices; ++v) g.vertex_face_offset[v + 1] += g.vertex_face_offset[v];
+  g.vertex_faces.resize(g.vertex_face_offset[g.n_vertices]);
+  {
+    std::vector<int> fill(g.vertex_face_offset.begin(), g.vertex_face_offset.end() - 1);
+    for (int f = 0; f < g.n_faces; ++f)
+      for (int v : g.face_vertices[f]) g.vertex_faces[fill[v]++] = f;
+  }
   g.frame_offset.assign(g.n_faces, 0.0);
   g.vertex_on_boundary.assign(g.n_vertices, 0);
   for (auto v : mesh.vertices()) g.vertex_on_boundary[v.idx()] = mesh.is_boundary(v);
@@ -126,8 +172,39 @@ GeometryCache build_geometry(const TriMesh& mesh) {
   return g;
 }
 
-void update_geometry(const TriMesh& mesh, GeometryCache& geometry) {
-  compute_geometry(mesh, geometry, true);
+void update_geometry(const TriMesh& mesh, GeometryCache& g) {
+  const bool incremental = static_cast<int>(g.positions.size()) == g.n_vertices &&
+                           static_cast<int>(mesh.n_vertices()) == g.n_vertices &&
+                           static_cast<int>(g.face_edges.size()) == g.n_faces &&
+                           static_cast<int>(g.vertex_face_offset.size()) == g.n_vertices + 1 &&
+                           static_cast<int>(g.edge_length.size()) == g.n_edges;
+  std::vector<int> moved;
+  if (incremental) {
+    for (auto v : mesh.vertices())
+      if (mesh.point(v) != g.positions[v.idx()]) moved.push_back(v.idx());
+    if (moved.empty()) return;  // the full computation would reproduce every value
+  }
+  if (!incremental || moved.size() * 8 > static_cast<size_t>(g.n_vertices)) {
+    compute_geometry(mesh, g, true);
+    return;
+  }
+  std::vector<int> faces, vertices, edges;
+  std::vector<char> seen_face(g.n_faces, 0);
+  for (int v : moved)
+    for (int i = g.vertex_face_offset[v]; i < g.vertex_face_offset[v + 1]; ++i) {
+      const int f = g.vertex_faces[i];
+      if (!seen_face[f]) seen_face[f] = 1, faces.push_back(f);
+    }
+  for (int f : faces) compute_face(mesh, g, f);
+  std::vector<char> seen_vertex(g.n_vertices, 0), seen_edge(g.n_edges, 0);
+  for (int f : faces) {
+    for (int v : g.face_vertices[f])
+      if (!seen_vertex[v]) seen_vertex[v] = 1, compute_defect(g, v);
+    for (int e : g.face_edges[f])
+      if (!seen_edge[e]) seen_edge[e] = 1, compute_edge(mesh, g, e, &g.kappa[e]);
+  }
+  compute_totals(mesh, g);
+  for (int v : moved) g.positions[v] = mesh.point(mesh.vertex_handle(v));
 }
 
 void set_frame_offsets(const TriMesh& mesh, GeometryCache& geometry, std::vector<double> offsets) {

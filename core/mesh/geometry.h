@@ -22,6 +22,11 @@ struct GeometryCache {
   //! Per edge: its two vertices (a < b). Size #E.
   std::vector<std::array<int, 2>> edge_vertices;
   std::vector<char> vertex_on_boundary;  //!< size #V
+  //! Per face: its three edges (size #F; update_geometry's incremental path).
+  std::vector<std::array<int, 3>> face_edges;
+  //! Faces around each vertex in increasing index order: vertex_faces[vertex_face_offset[v] ..
+  //! vertex_face_offset[v + 1]) (CSR; offsets size #V + 1).
+  std::vector<int> vertex_face_offset, vertex_faces;
 
   // ---- geometry ----
   std::vector<Vec3> face_normal;  //!< unit normals, size #F
@@ -39,6 +44,10 @@ struct GeometryCache {
   std::vector<double> kappa;
   double mean_edge_length = 0;
   double bbox_diagonal = 0;
+  //! The vertex positions this geometry was computed for (size #V) and each edge's length
+  //! (size #E): update_geometry recomputes only around vertices that moved since.
+  std::vector<Vec3> positions;
+  std::vector<double> edge_length;
 
   //! Angle (radians, ccw about the face normal) of a 3D vector in face f, measured from r_f.
   double angle_in_face(int f, const Vec3& v) const;
@@ -51,6 +60,10 @@ GeometryCache build_geometry(const TriMesh& mesh);
 
 //! Recomputes the geometric part after vertices moved, keeping the frames' choice of edge and
 //! continuing κ (κ_new = κ_old + wrap(κ_new − κ_old), never re-wrapped; algorithm.md §6.1).
+//! When few vertices moved since the last computation, only their faces, the vertices and
+//! edges of those faces are recomputed; the result is bit-identical to the full computation,
+//! except that κ of the other edges keeps its value (the full pass re-continues it, which can
+//! change its last bits).
 void update_geometry(const TriMesh& mesh, GeometryCache& geometry);
 
 //! Corner positions of face f in its local 2D frame (r_f, n_f × r_f), corner 0 at the origin;
