@@ -5,9 +5,18 @@
 // continuous run first reaches the discrete run's final E. Not a test.
 //
 //   qs_relocation_bench [--rings K] [--seeds N] [--max-steps S] [--case NAME] [--hop-all]
+//                       [--no-discrete] [--verbose] [--hop-OPTION VALUE ...]
 //
-// --hop-all: the continuous run's hop polish tries every neighbour of every node (no offset,
-// direction or work limit), an experiment against the defaults.
+// --hop-all: the continuous run's hop polish tries every neighbour of every relocated node (no
+// offset, direction or work limit), an experiment against the defaults.
+// --no-discrete: only the continuous run (E, CPU time, hop sweeps, hops, steps, fold-overs).
+// --verbose: the continuous run's steps, and per movable node at its end the valence, the angle
+// deficit at its vertex, its relocation offset and the best-fitting vertex within 2 rings.
+// --hop-min-offset X, --hop-candidates N, --hop-max-evaluations N, --hop-max-failures N,
+// --hop-collective 0|1, --hop-cones 0|1, --hop-cone-rings N, --hop-cone-targets N,
+// --hop-cone-max-failures N, --hop-rounds N: NodeOptOptions::hop_* / max_hop_rounds. The
+// session-4 polish: --hop-cones 0 --hop-collective 0 --hop-min-offset 0.25
+// --hop-max-evaluations 16 --hop-max-failures 0.
 //
 // Cases are built in process (tests/fixtures.cpp): the bundled ellipsoid sketch
 // (assets/example), a cube layout on an ellipsoid (cube_sphere(12), radii 1.3 / 1 / 0.75), the
@@ -17,6 +26,7 @@
 #include <time.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -43,14 +53,20 @@ double cpu_now() {
 // Records (CPU time since start, E) of every accepted step.
 struct Trace : qs::Observer {
   double start = 0;
+  bool verbose = false;  // print every step
   std::vector<std::pair<double, double>> accepted;
   void on_step(const qs::StepReport& r) override {
+    if (verbose)
+      std::printf("  step %d %s E %.6g %s moved %d α %.3g (%.2f s)\n", r.step, r.phase.c_str(), r.E,
+                  r.accepted ? "accepted" : "rejected", r.moved_nodes, r.step_size,
+                  cpu_now() - start);
     if (r.accepted) accepted.push_back({cpu_now() - start, r.E});
   }
-  // CPU time at which E first was ≤ target (negative: never).
-  double time_to(double target) const {
+  // CPU time at which E first was ≤ target (negative: never); \p floor: values below it are
+  // round-off (the polycube's exact layouts end at 1e-22 with E_init 30).
+  double time_to(double target, double floor) const {
     for (const auto& [t, E] : accepted)
-      if (E <= target * (1 + 1e-12)) return t;
+      if (E <= std::max(target * (1 + 1e-12), floor)) return t;
     return -1;
   }
 };
@@ -62,15 +78,71 @@ struct Case {
   int rings = 3;
 };
 
+// Angle deficit (2π − angle sum) at vertex v of \p mesh, in degrees.
+double deficit_deg(const qs::TriMesh& mesh, int v) {
+  const auto vh = mesh.vertex_handle(v);
+  double sum = 0;
+  for (auto h : mesh.voh_range(vh)) {
+    if (mesh.is_boundary(h)) continue;
+    const qs::Vec3 a = mesh.point(mesh.to_vertex_handle(h)) - mesh.point(vh);
+    const qs::Vec3 b =
+        mesh.point(mesh.to_vertex_handle(mesh.next_halfedge_handle(h))) - mesh.point(vh);
+    sum += std::acos(std::clamp((a | b) / (a.norm() * b.norm()), -1.0, 1.0));
+  }
+  return (2 * M_PI - sum) * 180 / M_PI;
+}
+
+// Per movable node of the result: valence, deficit at its vertex, relocation offset (mean
+// edges), and the vertex within 2 rings whose deficit best matches the node's index.
+void print_nodes(const qs::TriMesh& original, const qs::NodeOptResult& r) {
+  const double mean_edge = qs::build_geometry(original).mean_edge_length;
+  for (int n : qs::movable_nodes(original, r.layout)) {
+    const auto& node = r.layout.nodes[n];
+    int valence = 0;
+    for (const auto& a : r.layout.arcs) valence += (a.from == node.id) + (a.to == node.id);
+    const double want = (4 - valence) * 90.0;
+    const int v = node.vertex;
+    const auto vh = original.vertex_handle(v);
+    const double d = (r.mesh.point(vh) - original.point(vh)).norm() / mean_edge;
+    int best = v, best_ring = 0;
+    double best_err = std::abs(deficit_deg(original, v) - want);
+    for (auto w1 : original.vv_range(vh)) {
+      for (int ring : {1, 2}) {
+        std::vector<int> ws;
+        if (ring == 1)
+          ws.push_back(w1.idx());
+        else
+          for (auto w2 : original.vv_range(w1)) ws.push_back(w2.idx());
+        for (int w : ws) {
+          const double err = std::abs(deficit_deg(original, w) - want);
+          if (err < best_err - 1e-9) best = w, best_err = err, best_ring = ring;
+        }
+      }
+    }
+    std::printf(
+        "  node %d val %d deficit %.1f want %.0f offset %.3f | best %d (ring %d) deficit %.1f\n", n,
+        valence, deficit_deg(original, v), want, d, best, best_ring, deficit_deg(original, best));
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int rings = -1, seeds = 2, max_steps = 25;
-  bool hop_all = false;  // the hop polish tries every neighbour of every node
+  bool hop_all = false;      // the hop polish tries every neighbour of every node
+  bool no_discrete = false;  // skip the descent-only and discrete runs
+  bool verbose = false;      // print the continuous run's steps
   std::string only;
+  qs::NodeOptOptions hop;  // hop polish settings (--hop-* flags)
   for (int i = 1; i < argc; i += 2) {
     if (!std::strcmp(argv[i], "--hop-all")) {
       hop_all = true;
+      --i;
+    } else if (!std::strcmp(argv[i], "--verbose")) {
+      verbose = true;
+      --i;
+    } else if (!std::strcmp(argv[i], "--no-discrete")) {
+      no_discrete = true;
       --i;
     } else if (i + 1 >= argc) {
       std::fprintf(stderr, "qs_relocation_bench: %s needs a value\n", argv[i]);
@@ -83,10 +155,31 @@ int main(int argc, char** argv) {
       max_steps = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--case"))
       only = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--hop-cones"))
+      hop.hop_cones = std::atoi(argv[i + 1]) != 0;
+    else if (!std::strcmp(argv[i], "--hop-max-evaluations"))
+      hop.hop_max_evaluations = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--hop-min-offset"))
+      hop.hop_min_offset = std::atof(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--hop-candidates"))
+      hop.hop_candidates = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--hop-max-failures"))
+      hop.hop_max_failures = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--hop-collective"))
+      hop.hop_collective = std::atoi(argv[i + 1]) != 0;
+    else if (!std::strcmp(argv[i], "--hop-cone-rings"))
+      hop.hop_cone_rings = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--hop-cone-targets"))
+      hop.hop_cone_targets = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--hop-cone-max-failures"))
+      hop.hop_cone_max_failures = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--hop-rounds"))
+      hop.max_hop_rounds = std::atoi(argv[i + 1]);
     else {
       std::fprintf(stderr,
                    "usage: qs_relocation_bench [--rings K] [--seeds N] [--max-steps S] "
-                   "[--case NAME] [--hop-all]\n");
+                   "[--case NAME] [--hop-all] [--no-discrete] [--verbose] "
+                   "[--hop-OPTION VALUE ...]\n");
       return 2;
     }
   }
@@ -132,18 +225,31 @@ int main(int argc, char** argv) {
           start = qs::perturb_layout(c.mesh, c.layout, po).layout;
         }
         const qs::PipelineOptions options;
-        qs::NodeOptOptions no;
+        qs::NodeOptOptions no = hop;
         no.max_steps = max_steps;
         if (hop_all) {
           no.hop_min_offset = 0;
           no.hop_candidates = 0;
           no.hop_min_cos = -1;
           no.hop_max_evaluations = 1 << 20;
+          no.hop_max_failures = 0;
         }
         Trace cont;
+        cont.verbose = verbose;
         cont.start = cpu_now();
         const qs::NodeOptResult rc = qs::optimize_nodes(c.mesh, start, options, no, &cont);
         const double t_cont = cpu_now() - cont.start;
+        if (verbose) print_nodes(c.mesh, rc);
+        if (no_discrete) {
+          std::printf(
+              "%s | %zu | %zu | %d | %.6g | %.6g (%.2f) | hop sweeps %d, hops %d, steps %d, "
+              "fold-overs %d\n",
+              c.name.c_str(), static_cast<size_t>(c.mesh.n_faces()), c.layout.nodes.size(),
+              k > 0 ? seed : 0, rc.E_init, rc.E_final, t_cont, rc.hop_rounds, rc.hops, rc.steps,
+              rc.foldovers_final);
+          std::fflush(stdout);
+          continue;
+        }
 
         qs::NodeOptOptions plain = no;
         plain.hop_polish = false;
@@ -158,7 +264,7 @@ int main(int argc, char** argv) {
         const double t0 = cpu_now();
         const qs::NodeOptResult rx = qs::relocate_nodes_discrete(c.mesh, start, options, d);
         const double t_disc = cpu_now() - t0;
-        const double reach = cont.time_to(rx.E_final);
+        const double reach = cont.time_to(rx.E_final, 1e-12 * rc.E_init);
         std::printf("%s | %zu | %zu | %d | %.6g | %.6g (%.2f) | %.6g (%.2f) | %.6g (%.2f, %d) | ",
                     c.name.c_str(), static_cast<size_t>(c.mesh.n_faces()), c.layout.nodes.size(),
                     k > 0 ? seed : 0, rc.E_init, rc.E_final, t_cont, rd.E_final, t_desc, rx.E_final,

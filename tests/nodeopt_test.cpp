@@ -2,6 +2,7 @@
 // relocation with arc re-routing, the descent loop, pinning, stiffening, discrete baseline.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -868,6 +869,113 @@ TEST(NodeOptimizer, SwitchTabuSkipsRepeatedRejectedSwitches) {
     if (s.phase != "descent" || !s.accepted) continue;
     EXPECT_LE(s.E, last);
     last = s.E;
+  }
+}
+
+// Valence of every node of \p layout (arc ends; a loop counts twice).
+std::vector<int> node_valences(const Layout& layout) {
+  std::vector<int> out;
+  for (const auto& n : layout.nodes) {
+    int k = 0;
+    for (const auto& a : layout.arcs) k += (a.from == n.id) + (a.to == n.id);
+    out.push_back(k);
+  }
+  return out;
+}
+
+// Sharp cone vertices (discrete.h cone_candidates): on the genus-2 polycube every node of the
+// exact layout sits on a vertex whose angle deficit is 2π·index (corners ±π/2, Gauss–Bonnet
+// total −4π); a layout displaced by one ring has, for every displaced node of index ≠ 0, its
+// exact corner as first target; a node relocated off its corner is a restore candidate; a
+// smooth mesh has no candidates.
+TEST(DiscreteRelocation, ConeCandidatesFindPolycubeCorners) {
+  const auto poly = test::genus2_polycube(4);
+  const std::vector<double> deficit = vertex_angle_deficits(poly.mesh);
+  double total = 0;
+  for (double d : deficit) total += d;
+  EXPECT_NEAR(total, -4 * M_PI, 1e-9);
+  const std::vector<int> valence = node_valences(poly.layout);
+  std::vector<int> all(poly.layout.nodes.size());
+  for (size_t n = 0; n < all.size(); ++n) {
+    all[n] = static_cast<int>(n);
+    EXPECT_NEAR(deficit[poly.layout.nodes[n].vertex], 2 * M_PI * (4 - valence[n]) / 4.0, 1e-9);
+  }
+  const ConeCandidates exact =
+      cone_candidates(poly.mesh, poly.mesh, poly.layout, all, deficit, 0.25, 2, 2);
+  EXPECT_TRUE(exact.hop_nodes.empty());
+  EXPECT_TRUE(exact.snap_nodes.empty());
+
+  PerturbLayoutOptions po;
+  po.rings = 1;
+  po.seed = 2;
+  const Layout displaced = qs::perturb_layout(poly.mesh, poly.layout, po).layout;
+  const ConeCandidates c =
+      cone_candidates(poly.mesh, poly.mesh, displaced, all, deficit, 0.25, 2, 2);
+  int checked = 0;
+  for (size_t n = 0; n < all.size(); ++n) {
+    if (valence[n] == 4 || displaced.nodes[n].vertex == poly.layout.nodes[n].vertex) continue;
+    const auto it = std::find(c.hop_nodes.begin(), c.hop_nodes.end(), static_cast<int>(n));
+    ASSERT_NE(it, c.hop_nodes.end()) << "node " << n;
+    const auto& targets = c.hop_targets[it - c.hop_nodes.begin()];
+    ASSERT_FALSE(targets.empty());
+    EXPECT_EQ(targets[0], poly.layout.nodes[n].vertex) << "node " << n;
+    ++checked;
+  }
+  EXPECT_GT(checked, 10);
+  for (int n : c.hop_nodes) EXPECT_NE(valence[n], 4);
+
+  // Node 0 (on its corner) with its vertex relocated: a restore candidate.
+  TriMesh relocated = poly.mesh;
+  const auto vh = relocated.vertex_handle(poly.layout.nodes[0].vertex);
+  const auto wh = *relocated.vv_iter(vh);
+  relocated.set_point(vh, 0.8 * relocated.point(vh) + 0.2 * relocated.point(wh));
+  const ConeCandidates snap =
+      cone_candidates(poly.mesh, relocated, poly.layout, all, deficit, 0.25, 2, 2);
+  EXPECT_EQ(snap.snap_nodes, std::vector<int>{0});
+  EXPECT_TRUE(snap.hop_nodes.empty());
+
+  const auto smooth = test::cube_sphere(8, Vec3(1.3, 1, 0.75));
+  const std::vector<double> smooth_deficit = vertex_angle_deficits(smooth.mesh);
+  const Layout smooth_displaced = qs::perturb_layout(smooth.mesh, smooth.layout, po).layout;
+  std::vector<int> smooth_all(smooth.layout.nodes.size());
+  for (size_t n = 0; n < smooth_all.size(); ++n) smooth_all[n] = static_cast<int>(n);
+  const ConeCandidates none = cone_candidates(smooth.mesh, smooth.mesh, smooth_displaced,
+                                              smooth_all, smooth_deficit, 0.25, 2, 2);
+  EXPECT_TRUE(none.hop_nodes.empty());
+  EXPECT_TRUE(none.snap_nodes.empty());
+}
+
+// The hop polish (hop_collective, hop_cones) returns the displaced nodes of the genus-2
+// polycube to their corners, where the parameterization is isometric (E ≈ 0): the continuous
+// descent alone cannot (it never places a node exactly on a vertex's original point). Without
+// those passes the run ends far higher.
+TEST(NodeOptimizer, HopPolishReturnsPolycubeNodesToCorners) {
+  const auto poly = test::genus2_polycube(4);
+  const std::vector<double> deficit = vertex_angle_deficits(poly.mesh);
+  PerturbLayoutOptions po;
+  po.rings = 1;
+  po.seed = 1;
+  const Layout start = qs::perturb_layout(poly.mesh, poly.layout, po).layout;
+  Recorder rec;
+  const NodeOptResult r = optimize_nodes(poly.mesh, start, PipelineOptions{}, {}, &rec);
+  NodeOptOptions plain;
+  plain.hop_cones = false;
+  plain.hop_collective = false;
+  const NodeOptResult p = optimize_nodes(poly.mesh, start, PipelineOptions{}, plain);
+  std::printf(
+      "[stat] polycube seed 1: E %.6g -> %.6g (%d hop sweeps, %d moves); without the cone and "
+      "collective passes %.6g\n",
+      r.E_init, r.E_final, r.hop_rounds, r.hops, p.E_final);
+  expect_monotone(r, rec);
+  EXPECT_TRUE(validate_layout(r.mesh, r.layout).valid());
+  EXPECT_LT(r.E_final, 1e-6 * r.E_init);
+  EXPECT_GT(p.E_final, 1e-2 * p.E_init);
+  const std::vector<int> valence = node_valences(r.layout);
+  for (size_t n = 0; n < r.layout.nodes.size(); ++n) {
+    const int v = r.layout.nodes[n].vertex;
+    EXPECT_NEAR(deficit[v], 2 * M_PI * (4 - valence[n]) / 4.0, 1e-9) << "node " << n;
+    const auto vh = r.mesh.vertex_handle(v);
+    EXPECT_EQ(r.mesh.point(vh), poly.mesh.point(vh)) << "node " << n << " relocated";
   }
 }
 

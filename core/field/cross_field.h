@@ -116,9 +116,9 @@ class CrossFieldSolver {
   //! reference factorization) and re-solves; clusters that contradict the new layout are
   //! dropped as in the constructor (a factorization per drop pass, only when more edges
   //! mismatch than the constructor's passes left). Otherwise it sets up again as the
-  //! constructor (one numeric factorization with the kept analysis, plus drop passes).
-  //! Either way the field is a fresh construction's at this geometry up to solver round-off
-  //! (on the same-face path, unless a drop pass that the tolerance skips would have helped).
+  //! constructor (one numeric factorization with the kept analysis, plus drop passes with the
+  //! same tolerance). Either way the field is a fresh construction's at this geometry up to
+  //! solver round-off, unless a drop pass that the tolerance skips would have helped.
   //! \throw TopologyError as the constructor, InvalidInputError when the mesh size changed.
   const CrossField& update_layout(const TriMesh& mesh, const GeometryCache& geometry,
                                   const Layout& layout, const LayoutTopology& topology);
@@ -137,7 +137,7 @@ class CrossFieldSolver {
   //! The constructor after the constraints: period jumps, clusters, matrix, factorization
   //! (analysis reused on the same pattern), warm start, solve and drop passes.
   void setup(const TriMesh& mesh, const GeometryCache& geometry, const Layout& layout,
-             const LayoutTopology& topology, FieldConstraints constraints);
+             const LayoutTopology& topology, FieldConstraints constraints, int tolerated = 0);
   Eigen::VectorXd rhs(const GeometryCache& geometry, const std::vector<double>& c) const;
   std::vector<double> constraint_angles(const GeometryCache& geometry) const;
   void factorize(SpdSolver& solver, const Eigen::SparseMatrix<double>& A);  //!< timed, counted

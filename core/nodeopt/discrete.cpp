@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "core/base/timing.h"
 #include "core/nodeopt/gradient.h"
@@ -40,6 +41,84 @@ std::vector<int> hop_candidates(const TriMesh& original, const Layout& layout, i
 
 }  // namespace
 
+std::vector<double> vertex_angle_deficits(const TriMesh& mesh) {
+  std::vector<double> out(mesh.n_vertices(), 0.0);
+  for (auto vh : mesh.vertices()) {
+    if (mesh.is_boundary(vh)) continue;
+    double sum = 0;
+    for (auto h : mesh.voh_range(vh)) {
+      const Vec3 a = mesh.point(mesh.to_vertex_handle(h)) - mesh.point(vh);
+      const Vec3 b =
+          mesh.point(mesh.to_vertex_handle(mesh.next_halfedge_handle(h))) - mesh.point(vh);
+      const double la = a.norm(), lb = b.norm();
+      if (la > 0 && lb > 0) sum += std::acos(std::clamp((a | b) / (la * lb), -1.0, 1.0));
+    }
+    out[vh.idx()] = 2 * M_PI - sum;
+  }
+  return out;
+}
+
+ConeCandidates cone_candidates(const TriMesh& original, const TriMesh& mesh, const Layout& layout,
+                               const std::vector<int>& nodes, const std::vector<double>& deficits,
+                               double tolerance, int rings, int max_targets) {
+  ConeCandidates out;
+  std::vector<int> valence(layout.nodes.size(), 0);
+  {
+    std::vector<int> index_of_id;
+    for (size_t n = 0; n < layout.nodes.size(); ++n) {
+      const int id = layout.nodes[n].id;
+      if (id >= static_cast<int>(index_of_id.size())) index_of_id.resize(id + 1, -1);
+      index_of_id[id] = static_cast<int>(n);
+    }
+    auto count = [&](int id) {
+      if (id >= 0 && id < static_cast<int>(index_of_id.size()) && index_of_id[id] >= 0)
+        ++valence[index_of_id[id]];
+    };
+    for (const auto& a : layout.arcs) count(a.from), count(a.to);
+  }
+  const double tol = tolerance * M_PI / 2;
+  std::vector<int> seen(original.n_vertices(), -1);
+  for (int n : nodes) {
+    const double index = (4 - valence[n]) / 4.0;
+    if (index == 0) continue;
+    const double want = 2 * M_PI * index;
+    auto fits = [&](int w) { return std::abs(deficits[w] - want) <= tol; };
+    const int v = layout.nodes[n].vertex;
+    const auto vh = mesh.vertex_handle(v);
+    if (fits(v)) {
+      if (mesh.point(vh) != original.point(vh)) out.snap_nodes.push_back(n);
+      continue;
+    }
+    // Breadth-first rings around v (original connectivity); fitting vertices by ring, then by
+    // how well they fit.
+    std::vector<std::pair<std::pair<int, double>, int>> found;  // ((ring, misfit), vertex)
+    std::vector<int> frontier{v};
+    seen[v] = n;
+    for (int ring = 1; ring <= rings && !frontier.empty(); ++ring) {
+      std::vector<int> next;
+      for (int u : frontier)
+        for (auto wh : original.vv_range(original.vertex_handle(u))) {
+          const int w = wh.idx();
+          if (seen[w] == n) continue;
+          seen[w] = n;
+          next.push_back(w);
+          if (fits(w)) found.push_back({{ring, std::abs(deficits[w] - want)}, w});
+        }
+      frontier = std::move(next);
+    }
+    if (found.empty()) continue;
+    std::sort(found.begin(), found.end());
+    std::vector<int> targets;
+    for (const auto& f : found) {
+      if (static_cast<int>(targets.size()) >= max_targets) break;
+      targets.push_back(f.second);
+    }
+    out.hop_nodes.push_back(n);
+    out.hop_targets.push_back(std::move(targets));
+  }
+  return out;
+}
+
 HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
                          const std::vector<int>& nodes, const std::vector<Vec3>& directions,
                          double E, int foldovers, const HopSweepOptions& o,
@@ -48,17 +127,46 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
   HopSweepResult result;
   result.E = E;
   result.foldovers = foldovers;
+  int failures = 0;  // candidate solves since the last lower E
   for (size_t i = 0; i < nodes.size(); ++i) {
     const int n = nodes[i];
     const Vec3* direction = directions.empty() ? nullptr : &directions[i];
-    if (direction && direction->norm() <= 0) continue;
+    if (direction && direction->norm() <= 0) direction = nullptr;
     const int v = layout.nodes[n].vertex;
     const Vec3 restored = original.point(original.vertex_handle(v));
     Layout best_layout;
     int best_vertex = -1;
     double best_E = result.E;
     int best_foldovers = result.foldovers;
-    for (int w : hop_candidates(original, layout, n, direction, o)) {
+    if (o.try_restore && mesh.point(mesh.vertex_handle(v)) != restored &&
+        result.evaluations < o.max_evaluations &&
+        relocation_keeps_orientation(mesh, original, -1, v, restored, o.relocation)) {
+      check_cancel(observer);
+      TriMesh moved = mesh;
+      moved.set_point(moved.vertex_handle(v), restored);
+      ++result.evaluations;
+      double trial_E = 0;
+      int trial_foldovers = 0;
+      if (evaluate(moved, layout, trial_E, trial_foldovers) && trial_E < best_E) {
+        best_E = trial_E;
+        best_foldovers = trial_foldovers;
+        best_layout = layout;
+        best_vertex = v;
+        failures = 0;
+      } else {
+        ++failures;
+      }
+    }
+    std::vector<int> candidates;
+    if (!o.targets.empty()) {
+      const std::vector<char> forbidden = forbidden_relocation_vertices(original, layout, n);
+      for (int w : o.targets[i]) {
+        if (w != v && !forbidden[w]) candidates.push_back(w);
+      }
+    } else if (o.try_neighbours) {
+      candidates = hop_candidates(original, layout, n, direction, o);
+    }
+    for (int w : candidates) {
       if (result.evaluations >= o.max_evaluations) break;
       const Vec3 at = mesh.point(mesh.vertex_handle(w));
       if (!relocation_keeps_orientation(mesh, original, v, w, at, o.relocation)) continue;
@@ -76,7 +184,11 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
         best_foldovers = trial_foldovers;
         best_layout = std::move(trial);
         best_vertex = w;
+        failures = 0;
+      } else {
+        ++failures;
       }
+      if (o.max_failures > 0 && failures >= o.max_failures) break;
     }
     if (best_vertex >= 0) {
       layout = std::move(best_layout);
@@ -86,6 +198,7 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
       ++result.moved;
     }
     if (result.evaluations >= o.max_evaluations) break;
+    if (o.max_failures > 0 && failures >= o.max_failures) break;
   }
   return result;
 }

@@ -44,6 +44,19 @@ struct HopSweepOptions {
   double min_direction_cos = -1;
   int max_evaluations = 2000;    //!< candidate solves in this sweep (work cap)
   RelocationOptions relocation;  //!< re-routing of the moved node's arcs, orientation check
+  //! Before its neighbours, a node whose vertex is relocated (its position in the mesh differs
+  //! from \p original) tries staying on that vertex with the relocation undone (the vertex back
+  //! at its original position, layout unchanged): the continuous descent cannot reach a vertex's
+  //! own original position exactly, which matters at sharp (cone) vertices.
+  bool try_restore = false;
+  bool try_neighbours = true;  //!< false: only the restore candidate (try_restore)
+  //! When not empty (one list per entry of the sweep's nodes): node i tries exactly the vertices
+  //! targets[i], in order (any vertices, not only neighbours; forbidden ones are skipped),
+  //! instead of its neighbours.
+  std::vector<std::vector<int>> targets;
+  //! The sweep stops after this many candidate solves in a row that found no lower E
+  //! (≤ 0: no limit); with the most promising nodes first, the rest rarely pays.
+  int max_failures = 0;
 };
 
 struct HopSweepResult {
@@ -53,6 +66,30 @@ struct HopSweepResult {
   int foldovers = 0;    //!< fold-overs of the final state
 };
 
+//! Angle deficit 2π − Σ angles at every vertex of \p mesh (radians; boundary vertices 0).
+std::vector<double> vertex_angle_deficits(const TriMesh& mesh);
+
+//! Hop candidates at sharp cone vertices, which the continuous descent cannot reach (it never
+//! places a node exactly on a vertex's original position, and a relocated cone vertex loses its
+//! cone). A node of valence k has index ι = (4 − k)/4 and fits a vertex whose angle deficit is
+//! near 2πι (a polycube corner: 3 patches at π/2 deficit; 5 at −π/2).
+struct ConeCandidates {
+  //! Nodes on a fitting vertex whose relocation is not undone (restore candidates).
+  std::vector<int> snap_nodes;
+  //! Nodes on a vertex that does not fit, with fitting free vertices within the search rings
+  //! (nearest ring first): hop candidates.
+  std::vector<int> hop_nodes;
+  std::vector<std::vector<int>> hop_targets;
+};
+
+//! A vertex fits a node of index ι ≠ 0 when |deficit − 2πι| ≤ tolerance · π/2 (nodes of index
+//! 0 have no candidates, so smooth meshes have none). Searches \p rings rings of the original
+//! mesh around each of \p nodes (indices into layout.nodes) and keeps at most \p max_targets
+//! per node. \p deficits: vertex_angle_deficits(original).
+ConeCandidates cone_candidates(const TriMesh& original, const TriMesh& mesh, const Layout& layout,
+                               const std::vector<int>& nodes, const std::vector<double>& deficits,
+                               double tolerance, int rings, int max_targets);
+
 //! One Gauss–Seidel sweep of discrete hops. Each node of \p nodes (indices into layout.nodes), in
 //! order, tries its free neighbouring vertices w (not forbidden_relocation_vertices): the node
 //! moves to w (its arcs re-routed by move_node_and_reroute, routing metric \p mesh), its old
@@ -60,7 +97,8 @@ struct HopSweepResult {
 //! whose 1-rings would leave RelocationOptions' orientation bounds is skipped. The candidate
 //! with the lowest E is kept at once when it is below the current E (\p E at the start).
 //! \p directions is empty (no preference) or has one preferred direction per entry of \p nodes
-//! (3D; a zero vector: the node is skipped). \p mesh and \p layout are updated in place.
+//! (3D; a zero vector: no preference for that node). \p mesh and \p layout are updated in
+//! place.
 //! \pre mesh and original have the same connectivity; layout is valid on them.
 //! \throw Cancelled (polled before every solve).
 HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,

@@ -197,32 +197,16 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
   // Per movable node: the vertex it switched to in the last trial rejected at the current α, or
   // -1 (switch_tabu); and the targets of the trial being built.
   std::vector<int> rejected_target(movable.size(), -1), target;
-  // Hop sweep (discrete.h): nodes relocated far off their vertex try the neighbours in that
-  // direction. Returns true when a node hopped (state and current updated).
-  auto hop_round = [&]() {
+  // Hop sweep (discrete.h; NodeOptOptions::hop_polish): all relocations undone at once, cone
+  // restores and hops, then relocated nodes try the neighbours in the direction of their
+  // relocation. Returns true when E fell (state and current updated).
+  std::vector<double> deficits;  // angle deficits of the original mesh (hop_cones), on demand
+  // \p cones_only: the sweep before the descent (hop_cones_first): only the collective and cone
+  // passes, and nothing (no solve, no report) when no node has a cone candidate.
+  int polish_rounds = 0;  // sweeps after a descent phase (max_hop_rounds)
+  auto hop_round = [&](bool cones_only) {
     const auto t_hop = std::chrono::steady_clock::now();
     check_cancel(observer);
-    ++result.hop_rounds;
-    // The nodes relocated farthest off their vertex (the most strained) try first.
-    std::vector<std::pair<double, int>> strained;
-    for (int n : movable) {
-      const auto vh = original.vertex_handle(state.layout.nodes[n].vertex);
-      const double d = (state.mesh.point(vh) - original.point(vh)).norm();
-      if (d > 0 && d >= no.hop_min_offset * mean_edge) strained.push_back({-d, n});
-    }
-    std::sort(strained.begin(), strained.end());
-    std::vector<int> nodes;
-    std::vector<Vec3> directions;
-    for (const auto& [d, n] : strained) {  // directions: the relocation offsets
-      const auto vh = original.vertex_handle(state.layout.nodes[n].vertex);
-      nodes.push_back(n);
-      directions.push_back(state.mesh.point(vh) - original.point(vh));
-    }
-    HopSweepOptions sweep;
-    sweep.max_candidates = no.hop_candidates;
-    sweep.min_direction_cos = no.hop_min_cos;
-    sweep.max_evaluations = no.hop_max_evaluations;
-    sweep.relocation = no.relocation;
     const HopEvaluator evaluate = [&](const TriMesh& m, const Layout& l, double& E, int& folds) {
       try {
         const Evaluation ev = evaluate_switched(m, l);
@@ -236,14 +220,115 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
       }
     };
     State hopped = state;
-    const HopSweepResult h =
-        hop_sweep(original, hopped.mesh, hopped.layout, nodes, directions, current.E,
-                  current.foldovers, sweep, evaluate, observer, &reroute);
+    HopSweepResult h;
+    h.E = current.E;
+    h.foldovers = current.foldovers;
+    // One sweep over \p nodes of hopped (most strained first), accumulated into h.
+    auto sweep_nodes = [&](double min_offset, HopSweepOptions sweep) {
+      std::vector<std::pair<double, int>> strained;  // (−offset, node)
+      for (int n : movable) {
+        const auto vh = original.vertex_handle(hopped.layout.nodes[n].vertex);
+        const double d = (hopped.mesh.point(vh) - original.point(vh)).norm();
+        if (d > 0 && d >= min_offset * mean_edge) strained.push_back({-d, n});
+      }
+      std::sort(strained.begin(), strained.end());
+      std::vector<int> nodes;
+      std::vector<Vec3> directions;
+      for (const auto& [d, n] : strained) {  // directions: the relocation offsets
+        const auto vh = original.vertex_handle(hopped.layout.nodes[n].vertex);
+        nodes.push_back(n);
+        directions.push_back(hopped.mesh.point(vh) - original.point(vh));
+      }
+      sweep.relocation = no.relocation;
+      sweep.max_evaluations = no.hop_max_evaluations - h.evaluations;
+      if (nodes.empty() || sweep.max_evaluations <= 0) return;
+      const HopSweepResult s = hop_sweep(original, hopped.mesh, hopped.layout, nodes, directions,
+                                         h.E, h.foldovers, sweep, evaluate, observer, &reroute);
+      h.moved += s.moved;
+      h.evaluations += s.evaluations;
+      h.E = s.E;
+      h.foldovers = s.foldovers;
+    };
+    // Sharp cone vertices (discrete.h cone_candidates; none on smooth meshes).
+    ConeCandidates cones;
+    auto find_cones = [&]() {
+      if (!no.hop_cones) return;
+      if (deficits.empty()) deficits = vertex_angle_deficits(original);
+      cones = cone_candidates(original, hopped.mesh, hopped.layout, movable, deficits,
+                              no.hop_cone_tolerance, no.hop_cone_rings, no.hop_cone_targets);
+    };
+    find_cones();
+    if (cones_only && cones.hop_nodes.empty() && cones.snap_nodes.empty()) return false;
+    ++result.hop_rounds;
+    // All at once first, one solve (single moves miss collective optima: one node on its cone
+    // or vertex while its neighbours are not can raise E): every relocation undone and every
+    // node off its cone onto its nearest fitting vertex.
+    if (no.hop_collective) {
+      check_cancel(observer);
+      State all = hopped;
+      int moved = 0;
+      for (int n : movable) {
+        const auto vh = original.vertex_handle(all.layout.nodes[n].vertex);
+        moved += all.mesh.point(vh) != original.point(vh);
+      }
+      for (size_t i = 0; i < cones.hop_nodes.size(); ++i) {
+        const int n = cones.hop_nodes[i];
+        const std::vector<char> forbidden = forbidden_relocation_vertices(original, all.layout, n);
+        for (int w : cones.hop_targets[i])
+          if (!forbidden[w] &&
+              move_node_and_reroute(all.mesh, all.layout, n, w, no.relocation, &reroute)) {
+            ++moved;
+            break;
+          }
+      }
+      all.mesh = original;  // every relocation undone
+      double E = 0;
+      int folds = 0;
+      if (moved > 0 && evaluate(all.mesh, all.layout, E, folds) && E < h.E) {
+        hopped = std::move(all);
+        h.moved += moved;
+        h.E = E;
+        h.foldovers = folds;
+        find_cones();
+      }
+    }
+    // Then one node at a time (own budget): relocations off a fitting cone undone, and hops
+    // onto a fitting cone nearby.
+    auto cone_sweep = [&](const std::vector<int>& nodes, HopSweepOptions sweep) {
+      sweep.relocation = no.relocation;
+      sweep.max_evaluations = no.hop_cone_max_evaluations;
+      sweep.max_failures = no.hop_cone_max_failures;
+      if (nodes.empty()) return;
+      const HopSweepResult s = hop_sweep(original, hopped.mesh, hopped.layout, nodes, {}, h.E,
+                                         h.foldovers, sweep, evaluate, observer, &reroute);
+      h.moved += s.moved;
+      h.E = s.E;
+      h.foldovers = s.foldovers;
+    };
+    {
+      HopSweepOptions snap;
+      snap.try_restore = true;
+      snap.try_neighbours = false;
+      cone_sweep(cones.snap_nodes, snap);
+      HopSweepOptions onto;
+      onto.targets = cones.hop_targets;
+      cone_sweep(cones.hop_nodes, onto);
+    }
+    if (!cones_only) {  // relocated nodes, farthest off their vertex first, try neighbours
+      HopSweepOptions sweep;
+      sweep.max_candidates = no.hop_candidates;
+      sweep.min_direction_cos = no.hop_min_cos;
+      sweep.max_failures = no.hop_max_failures;
+      sweep_nodes(no.hop_min_offset, sweep);
+    }
     bool kept = false;
     if (h.moved > 0) {
-      for (int n : movable)
-        if (hopped.layout.nodes[n].vertex != state.layout.nodes[n].vertex)
-          hopped.anchor[n] = vertex_surface_point(original, hopped.layout.nodes[n].vertex);
+      for (int n : movable) {  // hopped or restored: the node sits at its vertex's original point
+        const int v = hopped.layout.nodes[n].vertex;
+        const auto vh = original.vertex_handle(v);
+        if (v != state.layout.nodes[n].vertex || hopped.mesh.point(vh) != state.mesh.point(vh))
+          hopped.anchor[n] = vertex_surface_point(original, v);
+      }
       check_cancel(observer);
       Evaluation next = evaluate_switched(hopped.mesh, hopped.layout);
       if (next.E <= current.E) {  // equal to h.E: the same deterministic solve
@@ -273,13 +358,16 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
   };
   // When a descent phase ends: a hop sweep; true when nodes hopped and a new phase begins.
   auto polish = [&]() {
-    if (!no.hop_polish || result.hop_rounds >= no.max_hop_rounds || !hop_round()) return false;
+    if (!no.hop_polish || polish_rounds >= no.max_hop_rounds) return false;
+    ++polish_rounds;
+    if (!hop_round(false)) return false;
     alpha = no.alpha;
     phase_halvings = 0;
     std::fill(rejected_target.begin(), rejected_target.end(), -1);
     step_budget = std::max(step_budget, result.steps + no.hop_descent_steps);
     return true;
   };
+  if (no.hop_polish && no.hop_cones_first && !movable.empty()) hop_round(true);
   while (!movable.empty()) {
     if (result.steps >= step_budget || phase_halvings > no.max_halvings) {
       if (polish()) continue;
