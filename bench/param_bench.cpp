@@ -4,7 +4,13 @@
 // with one stand-alone CHOLMOD numeric factorization + solve of the same reduced matrix measured
 // in the same run. Not a test.
 //
-//   qs_param_bench --mesh M --layout L [--repeat N]
+//   qs_param_bench --mesh M --layout L [--repeat N] [--detail]
+//
+// --detail adds, per repeat, the setup's parts (cut graph, labels, elimination, reduced-matrix
+// patterns) and CHOLMOD's symbolic analysis of the reduced matrix with its orderings: the
+// default (AMD, METIS when AMD fills a lot), AMD only, METIS only, and AMD on the wedge quotient
+// graph (grouped_amd_ordering, used by ParamOptions::wedge_ordering) with nnz(L) and the numeric
+// factorization + solve time of each (best of 3).
 //
 // Run with OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 OMP_THREAD_LIMIT=1 for CPU times that a
 // loaded machine does not inflate (Debian's CHOLMOD starts 4 OpenMP threads otherwise, and
@@ -30,11 +36,61 @@ namespace {
 using qs::bench::cpu_seconds;
 using qs::bench::median;
 
+// Eigen's supernodal LLᵀ with an analysis from a given ordering (as SpdSolver's).
+class Llt : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> {
+ public:
+  Llt() { cholmod().print = 0; }
+  void analyze_given(const Eigen::SparseMatrix<double>& A, std::vector<int>& perm) {
+    cholmod_sparse a = Eigen::viewAsCholmod(A.selfadjointView<Eigen::Lower>());
+    cholmod().nmethods = 1;
+    cholmod().method[0].ordering = CHOLMOD_GIVEN;
+    m_cholmodFactor = cholmod_analyze_p(&a, perm.data(), nullptr, 0, &cholmod());
+    m_isInitialized = true;
+    m_info = m_cholmodFactor ? Eigen::Success : Eigen::NumericalIssue;
+    m_analysisIsOk = m_cholmodFactor != nullptr;
+    m_factorizationIsOk = false;
+  }
+};
+
+// One analysis variant: nmethods/ordering (CHOLMOD's), or a given permutation. Prints the
+// analysis CPU time, nnz(L) and flops of the chosen ordering, and the factorization + solve CPU
+// time.
+void analysis_variant(const char* name, const Eigen::SparseMatrix<double>& A, int nmethods,
+                      int ordering, std::vector<int>* perm, double extra_s) {
+  Llt llt;
+  double c0 = cpu_seconds();
+  if (perm) {
+    llt.analyze_given(A, *perm);
+  } else {
+    llt.cholmod().nmethods = nmethods;
+    if (nmethods == 1) llt.cholmod().method[0].ordering = ordering;
+    llt.analyzePattern(A);
+  }
+  const double analyze = cpu_seconds() - c0 + extra_s;
+  const cholmod_common& c = llt.cholmod();
+  const double lnz = c.lnz, fl = c.fl;
+  const int chosen = perm ? CHOLMOD_GIVEN : c.method[c.selected].ordering;
+  // Best of 3: the factorization time of an ordering, with less load noise.
+  double unit = 1e30;
+  Eigen::VectorXd x;
+  for (int k = 0; k < 3; ++k) {
+    c0 = cpu_seconds();
+    llt.factorize(A);
+    x = llt.solve(Eigen::VectorXd::Ones(A.rows()));
+    unit = std::min(unit, cpu_seconds() - c0);
+  }
+  std::printf("  %-14s analyze %.4f (ordering %d) nnz(L) %.0f flops %.3g factorize+solve %.4f%s\n",
+              name, analyze, chosen, lnz, fl, unit, x.allFinite() ? "" : " (failed)");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::string mesh_path, layout_path;
   int repeat = 3;
+  bool detail = false;
+  for (int i = 1; i < argc; ++i)
+    if (!std::strcmp(argv[i], "--detail")) detail = true;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--mesh"))
       mesh_path = argv[i + 1];
@@ -93,6 +149,40 @@ int main(int argc, char** argv) {
           res.timings.factorize_s, res.timings.solve_s, trace, unit, analyze, stage / unit,
           res.unknowns, static_cast<long>(A.nonZeros()), res.energy, res.foldovers,
           ex.structurally_equivalent ? 1 : 0, x.allFinite() ? "" : " (unit solve failed)");
+      if (detail) {
+        std::vector<char> singular(p.geometry().n_vertices, 0);
+        for (int n = 0; n < p.topology().num_nodes; ++n)
+          if (p.topology().valence[n] != 4) singular[p.layout().nodes[n].vertex] = 1;
+        double d0 = cpu_seconds();
+        const qs::CutGraph cut =
+            qs::build_cut_graph(p.mesh(), p.geometry(), field.period_jump, singular);
+        const double t_cut = cpu_seconds() - d0;
+        d0 = cpu_seconds();
+        const qs::Labeling labels = qs::label_layout(p.mesh(), p.geometry(), p.layout(),
+                                                     p.topology(), field.period_jump, field.theta);
+        const double t_label = cpu_seconds() - d0;
+        d0 = cpu_seconds();
+        const qs::Reduction red = qs::eliminate_constraints(solver.constraints());
+        const double t_elim = cpu_seconds() - d0;
+        d0 = cpu_seconds();
+        const qs::ReducedAssembly patterns(cut.corner_wedge, cut.wedges,
+                                           solver.constraints().variables, red.Z);
+        const double t_patterns = cpu_seconds() - d0;
+        std::printf(
+            "  setup parts (CPU): cut graph %.4f labels %.4f elimination %.4f patterns %.4f "
+            "(rows %zu, wedges %d)\n",
+            t_cut, t_label, t_elim, t_patterns, solver.constraints().rows.size(), cut.wedges);
+        analysis_variant("default", A, 0, 0, nullptr, 0);
+        analysis_variant("AMD", A, 1, CHOLMOD_AMD, nullptr, 0);
+        analysis_variant("METIS", A, 1, CHOLMOD_METIS, nullptr, 0);
+        d0 = cpu_seconds();
+        const std::vector<int> group = qs::parameterization_groups(
+            solver.cut_graph().wedges, solver.reduction().free_index, static_cast<int>(A.cols()));
+        std::vector<int> order = qs::grouped_amd_ordering(A, group);
+        const double t_order = cpu_seconds() - d0;
+        std::printf("  wedge-grouped AMD ordering %.4f s CPU\n", t_order);
+        analysis_variant("wedge AMD", A, 0, 0, &order, t_order);
+      }
       stages.push_back(stage);
       units.push_back(unit);
       ratios.push_back(stage / unit);

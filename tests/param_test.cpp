@@ -1,6 +1,7 @@
 // Seamless parameterization with layout constraints (issue #4).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/extract/tracing.h"
@@ -136,6 +137,47 @@ TEST(Parameterization, FlatDiskGridIsIsometric) {
   EXPECT_EQ(r.foldovers, 0);
   EXPECT_LT(r.energy, 1e-10 * 96);
   expect_valid_embedding(in, s);
+}
+
+// ParamOptions::wedge_ordering: the linear solver's analysis uses the wedge-graph ordering
+// (one group per wedge, holding only that wedge's unknowns), and the solution is the default
+// ordering's up to round-off (the reduced system has a unique solution).
+TEST(Parameterization, WedgeOrderingIsUsedAndGivesTheSameSolution) {
+  const auto in = test::cube_sphere(8);
+  ParamOptions wedge;
+  wedge.wedge_ordering = true;
+  const Solved a = solve_all(in), b = solve_all(in, wedge);
+  EXPECT_EQ(a.param->linear_solver().stats().hinted_analyses, 0);
+  EXPECT_EQ(b.param->linear_solver().stats().hinted_analyses, 1);
+  const Reduction& red = b.param->reduction();
+  const int wedges = b.param->cut_graph().wedges;
+  const int free = static_cast<int>(red.Z.cols());
+  const std::vector<int> group = parameterization_groups(wedges, red.free_index, free);
+  ASSERT_EQ(group.size(), static_cast<size_t>(free));
+  std::vector<int> group_wedge(free, -2), group_size(free, 0);
+  for (int i = 0; i < static_cast<int>(red.free_index.size()); ++i) {
+    const int k = red.free_index[i];
+    if (k < 0) continue;
+    const int w = i < 2 * wedges ? i / 2 : -1;  // -1: a seam translation, alone in its group
+    const int g = group[k];
+    ASSERT_GE(g, 0);
+    ASSERT_LT(g, free);
+    if (group_wedge[g] == -2) group_wedge[g] = w;
+    EXPECT_EQ(group_wedge[g], w) << "unknown " << k;
+    EXPECT_LE(++group_size[g], w < 0 ? 1 : 2);
+  }
+  const auto& ua = a.param->result().corner_uv;
+  const auto& ub = b.param->result().corner_uv;
+  ASSERT_EQ(ua.size(), ub.size());
+  double worst = 0, scale = 0;
+  for (size_t c = 0; c < ua.size(); ++c)
+    for (int k = 0; k < 2; ++k) {
+      worst = std::max(worst, std::abs(ua[c][k] - ub[c][k]));
+      scale = std::max(scale, std::abs(ua[c][k]));
+    }
+  EXPECT_GT(scale, 0);
+  EXPECT_LT(worst, 1e-9 * scale);
+  EXPECT_NEAR(a.param->result().energy, b.param->result().energy, 1e-9 * a.param->result().energy);
 }
 
 }  // namespace

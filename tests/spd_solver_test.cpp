@@ -3,9 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <thread>
 #include <vector>
 
 #include "core/base/errors.h"
@@ -23,7 +25,7 @@ Eigen::SparseMatrix<double> grid_matrix(int n, double shift, double bump = 0) {
     for (int j = 0; j < n; ++j) {
       const int a = id(i, j);
       double diag = shift + (a % 3 == 0 ? bump : 0.0);
-      for (const auto [di, dj] : {std::pair{1, 0}, std::pair{0, 1}}) {
+      for (const auto& [di, dj] : {std::pair{1, 0}, std::pair{0, 1}}) {
         if (i + di >= n || j + dj >= n) continue;
         const int b = id(i + di, j + dj);
         t.emplace_back(a, b, -1.0);
@@ -113,6 +115,100 @@ TEST(SpdSolver, RejectsIndefiniteAndNonFiniteInput) {
   EXPECT_THROW(solver.solve(b), SolverError);
   Eigen::SparseMatrix<double> rect(3, 4);
   EXPECT_THROW(solver.analyze(rect), SolverError);
+}
+
+// Two grid Laplacians interleaved (unknown 2k: first copy at node k, 2k + 1: second copy),
+// coupled at a few nodes, like the u and v unknowns of the parameterization's wedges.
+Eigen::SparseMatrix<double> paired_grid(int n) {
+  const Eigen::SparseMatrix<double> G = grid_matrix(n, 0.1);
+  std::vector<Eigen::Triplet<double>> t;
+  for (int k = 0; k < G.outerSize(); ++k)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(G, k); it; ++it) {
+      t.emplace_back(2 * it.row(), 2 * it.col(), it.value());
+      t.emplace_back(2 * it.row() + 1, 2 * it.col() + 1, 1.5 * it.value());
+    }
+  for (int k = 0; k + 1 < n * n; k += 7) {  // u_k — v_{k+1} couplings (weakly: stays SPD)
+    t.emplace_back(2 * k, 2 * (k + 1) + 1, 0.05);
+    t.emplace_back(2 * (k + 1) + 1, 2 * k, 0.05);
+  }
+  Eigen::SparseMatrix<double> A(2 * n * n, 2 * n * n);
+  A.setFromTriplets(t.begin(), t.end());
+  A.makeCompressed();
+  return A;
+}
+
+TEST(SpdSolver, GroupedAmdOrderingIsUsedAndGivesTheSameSolution) {
+  const int n = 24;
+  const auto A = paired_grid(n);
+  const int size = static_cast<int>(A.rows());
+  std::vector<int> group(size);
+  for (int k = 0; k < size; ++k) group[k] = k / 2;
+  const std::vector<int> order = grouped_amd_ordering(A, group);
+  ASSERT_EQ(order.size(), static_cast<size_t>(size));
+  std::vector<int> sorted = order;
+  std::sort(sorted.begin(), sorted.end());
+  for (int k = 0; k < size; ++k) ASSERT_EQ(sorted[k], k) << "not a permutation";
+  // The unknowns of a group are consecutive, in increasing index.
+  for (int k = 0; k < size; k += 2) {
+    EXPECT_EQ(group[order[k]], group[order[k + 1]]) << "position " << k;
+    EXPECT_LT(order[k], order[k + 1]);
+  }
+  // Not the identity: a fill-reducing ordering of a grid reorders it.
+  EXPECT_FALSE(std::is_sorted(order.begin(), order.end()));
+  const Eigen::VectorXd b = random_vector(size, 5);
+  SpdSolver hinted("hinted"), reference("reference");
+  hinted.set_ordering_hint(order);
+  hinted.factorize(A);
+  EXPECT_EQ(hinted.stats().hinted_analyses, 1);
+  EXPECT_EQ(hinted.ordering().size(), order.size());
+  reference.factorize(A);
+  EXPECT_EQ(reference.stats().hinted_analyses, 0);
+  const Eigen::VectorXd xh = hinted.solve(b), xr = reference.solve(b);
+  EXPECT_LT(relative_residual(A, xh, b), 1e-10);
+  EXPECT_LT((xh - xr).norm(), 1e-9 * xr.norm());
+  // Groups that do not fit: no ordering.
+  EXPECT_TRUE(grouped_amd_ordering(A, std::vector<int>(size - 1, 0)).empty());
+  std::vector<int> bad = group;
+  bad[3] = size;
+  EXPECT_TRUE(grouped_amd_ordering(A, bad).empty());
+  bad[3] = -1;
+  EXPECT_TRUE(grouped_amd_ordering(A, bad).empty());
+}
+
+// A copy shares the factorization until unshare(): then both solve on two threads at the same
+// time (run under TSan in CI) with the original's results, and refactorizing one leaves the
+// other's factorization alone.
+TEST(SpdSolver, UnsharedCopySolvesConcurrently) {
+  const auto A = grid_matrix(30, 0.05);
+  const auto A2 = grid_matrix(30, 0.05, 4.0);
+  const Eigen::VectorXd b = random_vector(static_cast<int>(A.rows()), 7);
+  SpdSolver original("original");
+  original.factorize(A);
+  const Eigen::VectorXd expected = original.solve(b);
+  SpdSolver copy = original;
+  copy.unshare();
+  EXPECT_TRUE(copy.factorized());
+  EXPECT_TRUE(copy.same_pattern(A));
+  Eigen::VectorXd x_copy;
+  std::thread other([&]() {
+    for (int k = 0; k < 20; ++k) x_copy = copy.solve(b);
+  });
+  Eigen::VectorXd x_original;
+  for (int k = 0; k < 20; ++k) x_original = original.solve(b);
+  other.join();
+  EXPECT_EQ(x_original, expected);
+  EXPECT_EQ(x_copy, expected);                 // the same factor, copied
+  const int analyses = copy.stats().analyses;  // counters are copied too
+  copy.factorize(A2);                          // no analysis: the copied one is reused
+  EXPECT_EQ(copy.stats().analyses, analyses);
+  EXPECT_LT(relative_residual(A2, copy.solve(b), b), 1e-10);
+  EXPECT_EQ(original.solve(b), expected);
+  // Unsharing an unshared or empty solver changes nothing.
+  SpdSolver empty("empty");
+  empty.unshare();
+  EXPECT_FALSE(empty.factorized());
+  original.unshare();
+  EXPECT_EQ(original.solve(b), expected);
 }
 
 }  // namespace

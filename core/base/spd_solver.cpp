@@ -3,6 +3,7 @@
 #include <Eigen/CholmodSupport>
 #include <algorithm>
 #include <chrono>
+#include <numeric>
 #include <vector>
 
 #include "core/base/errors.h"
@@ -33,6 +34,13 @@ class SupernodalLlt
     m_info = Eigen::Success;
     m_analysisIsOk = true;
     m_factorizationIsOk = false;
+    return true;
+  }
+  //! Copy of \p from's whole factor (symbolic and numeric) and its factorized state.
+  bool copy_factor_from(SupernodalLlt& from) {
+    if (!copy_analysis_from(from)) return false;
+    m_factorizationIsOk = from.m_factorizationIsOk;
+    m_info = from.m_info;
     return true;
   }
   //! Symbolic analysis with the fill-reducing ordering \p perm (size n, perm[k] = the column
@@ -90,6 +98,20 @@ void SpdSolver::detach(bool keep_analysis) {
     own->inner = impl_->inner;
     own->analyzed = true;
   }
+  impl_ = std::move(own);
+}
+
+void SpdSolver::unshare() {
+  if (impl_.use_count() <= 1) return;
+  auto own = std::make_shared<Impl>();
+  if (impl_->analyzed && !own->llt.copy_factor_from(impl_->llt))
+    throw SolverError(stage_ + ": could not copy the factorization");
+  own->rows = impl_->rows;
+  own->nnz = impl_->nnz;
+  own->outer = impl_->outer;
+  own->inner = impl_->inner;
+  own->analyzed = impl_->analyzed;
+  own->factorized = impl_->factorized;
   impl_ = std::move(own);
 }
 
@@ -215,6 +237,72 @@ void SpdSolver::set_ordering_hint(std::vector<int> ordering) {
     }
   }
   ordering_hint_ = std::move(ordering);
+}
+
+std::vector<int> grouped_amd_ordering(const Eigen::SparseMatrix<double>& A,
+                                      const std::vector<int>& group) {
+  const int n = static_cast<int>(A.cols());
+  if (A.rows() != A.cols() || static_cast<int>(group.size()) != n || n == 0) return {};
+  int groups = 0;
+  for (int g : group) {
+    if (g < 0 || g >= n) return {};
+    groups = std::max(groups, g + 1);
+  }
+  // Members of each group (CSR, increasing index).
+  std::vector<int> member_start(groups + 1, 0), members(n);
+  for (int g : group) ++member_start[g + 1];
+  for (int g = 0; g < groups; ++g) member_start[g + 1] += member_start[g];
+  {
+    std::vector<int> next(member_start.begin(), member_start.end() - 1);
+    for (int k = 0; k < n; ++k) members[next[group[k]]++] = k;
+  }
+  // Quotient graph, upper triangle (row < column), one entry per adjacent pair of groups.
+  std::vector<int> qp(groups + 1, 0), qi;
+  qi.reserve(static_cast<size_t>(A.nonZeros()) / 4 + groups);
+  std::vector<int> mark(groups, -1);
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
+  const int* nnz = A.innerNonZeroPtr();  // null when compressed
+  for (int g = 0; g < groups; ++g) {
+    mark[g] = g;
+    for (int q = member_start[g]; q < member_start[g + 1]; ++q) {
+      const int k = members[q];
+      const int end = nnz ? outer[k] + nnz[k] : outer[k + 1];
+      for (int p = outer[k]; p < end; ++p) {
+        const int h = group[inner[p]];
+        if (h < g && mark[h] != g) {
+          mark[h] = g;
+          qi.push_back(h);
+        }
+      }
+    }
+    qp[g + 1] = static_cast<int>(qi.size());
+  }
+  cholmod_common c;
+  cholmod_start(&c);
+  c.print = 0;
+  cholmod_sparse Q{};
+  Q.nrow = Q.ncol = static_cast<size_t>(groups);
+  Q.nzmax = qi.size();
+  Q.p = qp.data();
+  Q.i = qi.empty() ? nullptr : qi.data();
+  Q.stype = 1;  // upper triangle
+  Q.itype = CHOLMOD_INT;
+  Q.xtype = CHOLMOD_PATTERN;
+  Q.dtype = CHOLMOD_DOUBLE;
+  Q.sorted = 0;
+  Q.packed = 1;
+  std::vector<int> qperm(groups);
+  const int ok = qi.empty() ? 1 : cholmod_amd(&Q, nullptr, 0, qperm.data(), &c);
+  if (qi.empty()) std::iota(qperm.begin(), qperm.end(), 0);
+  cholmod_finish(&c);
+  if (!ok) return {};
+  std::vector<int> perm;
+  perm.reserve(n);
+  for (int g : qperm)
+    perm.insert(perm.end(), members.begin() + member_start[g],
+                members.begin() + member_start[g + 1]);
+  return perm;
 }
 
 }  // namespace qs

@@ -43,6 +43,11 @@ class SpdSolver {
   //! pattern needs no analysis of its own. Any factorization of this solver is dropped.
   //! \return false (and nothing changed) when \p other has no analysis of a compressed matrix.
   bool copy_analysis_from(const SpdSolver& other);
+  //! When a copy shares this solver's state (copies share it until one side analyzes or
+  //! factorizes), gives this one its own copy of the CHOLMOD factor, numeric values and
+  //! factorized state included: afterwards the two can be used on different threads at the
+  //! same time (a shared state's solves would share CHOLMOD's workspace).
+  void unshare();
   //! True when the last analysis was of exactly the pattern of \p A (compressed storage).
   bool same_pattern(const Eigen::SparseMatrix<double>& A) const;
   //! Solves A x = b with the last factorization. \throw SolverError on non-finite results.
@@ -72,5 +77,17 @@ class SpdSolver {
   SpdSolverStats stats_;
   std::vector<int> ordering_hint_;  //!< for the next analysis (set_ordering_hint)
 };
+
+//! A fill-reducing ordering of the symmetric \p A (both triangles stored, as
+//! ReducedAssembly::A) for SpdSolver::set_ordering_hint: AMD on the quotient graph in which
+//! the unknowns with the same \p group (size n, values in [0, n); e.g. the u and v unknowns of
+//! one parameterization wedge) form one node, expanded back with the unknowns of a group
+//! consecutive (increasing index). The quotient graph is smaller than A's graph (about a quarter
+//! of its edges for pairs), so the ordering costs less than CHOLMOD's AMD on A; when the
+//! unknowns of a group have (nearly) the same pattern the fill is the same.
+//! \return a permutation of 0..n−1 (entry k: the unknown eliminated k-th); empty when \p group
+//! does not fit A or AMD fails.
+std::vector<int> grouped_amd_ordering(const Eigen::SparseMatrix<double>& A,
+                                      const std::vector<int>& group);
 
 }  // namespace qs

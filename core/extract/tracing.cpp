@@ -49,6 +49,16 @@ class Tracer {
     for (long step = 0; step < cap; ++step) {
       // Candidates in the current face: vertex hits and edge crossings ahead along dir.
       const auto& fv = g_.face_vertices[face];
+      // fh[k]: the face's halfedge fv[k] → fv[k + 1] (the face's own loop: no vertex
+      // circulation as in find_halfedge).
+      HH fh[3];
+      {
+        HH h = mesh_.halfedge_handle(mesh_.face_handle(face));
+        for (int i = 0; i < 3; ++i, h = mesh_.next_halfedge_handle(h)) {
+          const int from = mesh_.from_vertex_handle(h).idx();
+          fh[from == fv[0] ? 0 : (from == fv[1] ? 1 : 2)] = h;
+        }
+      }
       const int axis = std::abs(dir[0]) > 0.5 ? 1 : 0;  // constant coordinate
       const double c = point[axis];
       double diam = 0;
@@ -73,8 +83,7 @@ class Tracer {
         const int l = (k + 1) % 3;
         if (snapped[k] || snapped[l]) continue;
         if ((lam[k] > 0) == (lam[l] > 0)) continue;
-        const HH h = mesh_.find_halfedge(mesh_.vertex_handle(fv[k]), mesh_.vertex_handle(fv[l]));
-        if (h == entry) continue;
+        if (fh[k] == entry) continue;
         const double t = lam[k] / (lam[k] - lam[l]);
         const double prog = dot(sub(lerp(uv_[3 * face + k], uv_[3 * face + l], t), point), dir);
         if (prog > best) best = prog, best_edge = k, best_t = t, best_vertex = -1;
@@ -109,7 +118,7 @@ class Tracer {
       }
       // Edge crossing.
       const int k = best_edge, l = (k + 1) % 3;
-      const HH h = mesh_.find_halfedge(mesh_.vertex_handle(fv[k]), mesh_.vertex_handle(fv[l]));
+      const HH h = fh[k];
       add_edge_sample(out, face, k, best_t);
       const HH opp = mesh_.opposite_halfedge_handle(h);
       if (mesh_.is_boundary(opp)) {
@@ -279,26 +288,43 @@ Extraction extract_layout(const TriMesh& mesh, const GeometryCache& g, const Lay
     if (!ex.arcs[a].ok)
       ex.problems.push_back("arc " + std::to_string(layout.arcs[a].id) + ": " + ex.arcs[a].failure);
   }
-  // Crossings: segments of different arcs inside one face (in that face's chart).
-  std::vector<std::vector<std::pair<int, int>>> face_segments(g.n_faces);  // (arc, sample index)
+  // Crossings: segments of different arcs inside one face (in that face's chart). Segment i of
+  // an arc (samples i, i + 1) lies in sample i + 1's face: both samples are on the boundary of
+  // a common face, the one traversed. Segments by face (CSR, counting sort), and each
+  // segment's end points in the face's chart computed once per face.
+  std::vector<int> seg_start(g.n_faces + 1, 0);
   for (int a = 0; a < topo.num_arcs; ++a) {
     const auto& s = ex.arcs[a].samples;
-    for (size_t i = 0; i + 1 < s.size(); ++i) {
-      // Segment i..i+1 lies in the face of sample i+1's predecessor crossing: both samples are
-      // on the boundary of a common face; use sample i+1's face when it is the one traversed.
-      face_segments[s[i + 1].face].push_back({a, static_cast<int>(i)});
+    for (size_t i = 0; i + 1 < s.size(); ++i) ++seg_start[s[i + 1].face + 1];
+  }
+  for (int f = 0; f < g.n_faces; ++f) seg_start[f + 1] += seg_start[f];
+  std::vector<std::pair<int, int>> segments(seg_start[g.n_faces]);  // (arc, sample index)
+  {
+    std::vector<int> next(seg_start.begin(), seg_start.end() - 1);
+    for (int a = 0; a < topo.num_arcs; ++a) {
+      const auto& s = ex.arcs[a].samples;
+      for (size_t i = 0; i + 1 < s.size(); ++i)
+        segments[next[s[i + 1].face]++] = {a, static_cast<int>(i)};
     }
   }
-  auto local_uv = [&](const SurfacePoint& sp, int f) { return uv_in_face(mesh, g, uv, sp, f); };
+  std::vector<std::array<V2, 2>> ends;  // per segment of the current face: its end points
   for (int f = 0; f < g.n_faces; ++f) {
-    const auto& segs = face_segments[f];
-    for (size_t i = 0; i < segs.size(); ++i)
-      for (size_t j = i + 1; j < segs.size(); ++j) {
+    const int first = seg_start[f], count = seg_start[f + 1] - first;
+    if (count < 2) continue;
+    const std::pair<int, int>* segs = &segments[first];
+    bool several_arcs = false;
+    for (int i = 1; i < count; ++i) several_arcs |= segs[i].first != segs[0].first;
+    if (!several_arcs) continue;
+    ends.resize(count);
+    for (int i = 0; i < count; ++i) {
+      const auto& si = ex.arcs[segs[i].first].samples;
+      ends[i] = {uv_in_face(mesh, g, uv, si[segs[i].second], f),
+                 uv_in_face(mesh, g, uv, si[segs[i].second + 1], f)};
+    }
+    for (int i = 0; i < count; ++i)
+      for (int j = i + 1; j < count; ++j) {
         if (segs[i].first == segs[j].first) continue;
-        const auto& si = ex.arcs[segs[i].first].samples;
-        const auto& sj = ex.arcs[segs[j].first].samples;
-        const V2 a0 = local_uv(si[segs[i].second], f), a1 = local_uv(si[segs[i].second + 1], f);
-        const V2 b0 = local_uv(sj[segs[j].second], f), b1 = local_uv(sj[segs[j].second + 1], f);
+        const V2 &a0 = ends[i][0], &a1 = ends[i][1], &b0 = ends[j][0], &b1 = ends[j][1];
         const double d1 = cross(sub(a1, a0), sub(b0, a0)), d2 = cross(sub(a1, a0), sub(b1, a0));
         const double d3 = cross(sub(b1, b0), sub(a0, b0)), d4 = cross(sub(b1, b0), sub(a1, b0));
         const double tol = 1e-12 * (norm(sub(a1, a0)) * norm(sub(b1, b0)) + 1e-300);

@@ -192,7 +192,7 @@ Reduction eliminate_constraints(const ConstraintSystem& sys, double tolerance) {
 
   // Pass 2: the deferred rows, reduced over pass 1's free variables, eliminated among
   // themselves (few rows, few variables).
-  Store second(n);
+  Store second(deferred.empty() ? 0 : n);  // unused (empty) without deferred rows
   for (int r : deferred) {
     const LinearRow& row = sys.rows[r];
     double rhs = row.rhs, scale = 0;
@@ -242,7 +242,7 @@ Reduction eliminate_constraints(const ConstraintSystem& sys, double tolerance) {
   for (int v = 0; v < n; ++v) {
     if (first.eliminated[v]) {
       expr[v] = &first.expr[v], constant[v] = first.constant[v];
-    } else if (second.eliminated[v]) {
+    } else if (!deferred.empty() && second.eliminated[v]) {
       expr[v] = &second.expr[v], constant[v] = second.constant[v];
     } else {
       red.free_index[v] = m++;
@@ -253,6 +253,12 @@ Reduction eliminate_constraints(const ConstraintSystem& sys, double tolerance) {
   // once to column-major.
   std::vector<int> outer(n + 1, 0), inner;
   std::vector<double> values;
+  {
+    size_t nz = 0;
+    for (int v = 0; v < n; ++v) nz += expr[v] ? expr[v]->size() : 1;
+    inner.reserve(nz);
+    values.reserve(nz);
+  }
   for (int v = 0; v < n; ++v) {
     if (!expr[v]) {
       inner.push_back(red.free_index[v]);

@@ -32,6 +32,22 @@ struct ConstraintSystem {
 };
 
 struct Reduction {
+  Reduction() = default;
+  Reduction(const Reduction&) = default;
+  Reduction& operator=(const Reduction&) = default;
+  //! Moves swap Z: Eigen 3.4.0's SparseMatrix has no move operations, so the implicit ones
+  //! would copy it.
+  Reduction(Reduction&& other) noexcept { *this = std::move(other); }
+  Reduction& operator=(Reduction&& other) noexcept {
+    Z.swap(other.Z);
+    z0.swap(other.z0);
+    free_index.swap(other.free_index);
+    eliminated = other.eliminated;
+    redundant = other.redundant;
+    redundant_origins.swap(other.redundant_origins);
+    return *this;
+  }
+
   Eigen::SparseMatrix<double> Z;  //!< variables × free
   Eigen::VectorXd z0;             //!< size variables
   std::vector<int> free_index;    //!< per variable: column of Z, or -1 if eliminated

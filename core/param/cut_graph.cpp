@@ -15,14 +15,15 @@ CutGraph build_cut_graph(const TriMesh& mesh, const GeometryCache& g, const std:
   // Spanning tree of faces across identity-transition edges (BFS); every other interior edge
   // is cut. The period-jump tree of topology.cpp has p = 0, so every face is reached.
   const std::vector<char> tree = dual_spanning_tree(mesh, [&](int e) { return p[e] % 4 == 0; });
-  std::vector<int> valence(g.n_vertices, 0);
+  // Per vertex: the number of cut edges at it and the XOR of their indices, which is the
+  // index of the only one when there is one (no adjacency walk needed while retracting).
+  std::vector<int> valence(g.n_vertices, 0), edge_xor(g.n_vertices, 0);
   for (int e = 0; e < ne; ++e) {
     if (g.edge_face_i[e] < 0 || g.edge_face_j[e] < 0 || tree[e]) continue;
     cg.cut[e] = 1;
-    ++valence[g.edge_vertices[e][0]];
-    ++valence[g.edge_vertices[e][1]];
+    for (int v : g.edge_vertices[e]) ++valence[v], edge_xor[v] ^= e;
   }
-  // Retract dangling branches.
+  // Retract dangling branches (the result does not depend on the order).
   std::vector<int> stack;
   for (int v = 0; v < g.n_vertices; ++v)
     if (valence[v] == 1 && !singular[v]) stack.push_back(v);
@@ -30,15 +31,12 @@ CutGraph build_cut_graph(const TriMesh& mesh, const GeometryCache& g, const std:
     const int v = stack.back();
     stack.pop_back();
     if (valence[v] != 1 || singular[v]) continue;
-    for (auto h : mesh.voh_range(mesh.vertex_handle(v))) {
-      const int e = mesh.edge_handle(h).idx();
-      if (!cg.cut[e]) continue;
-      if (p[e] % 4 != 0) break;  // a rotation seam stays
-      cg.cut[e] = 0;
-      --valence[v];
-      const int w = mesh.to_vertex_handle(h).idx();
-      if (--valence[w] == 1 && !singular[w]) stack.push_back(w);
-      break;
+    const int e = edge_xor[v];
+    if (p[e] % 4 != 0) continue;  // a rotation seam stays
+    cg.cut[e] = 0;
+    for (int x : g.edge_vertices[e]) {
+      edge_xor[x] ^= e;
+      if (--valence[x] == 1 && x != v && !singular[x]) stack.push_back(x);
     }
   }
   for (int e = 0; e < ne; ++e) cg.cut_edges += cg.cut[e];

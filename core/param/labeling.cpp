@@ -23,10 +23,9 @@ bool left_strip(const TriMesh& mesh, const std::vector<int>& walk, ArcStrip& s) 
   s.arrival.assign(walk.size(), 0);
   const HH first = mesh.find_halfedge(mesh.vertex_handle(walk[0]), mesh.vertex_handle(walk[1]));
   if (mesh.is_boundary(first)) return false;
+  HH h_in = first;  // walk[k − 1] → walk[k]
   for (size_t k = 1; k + 1 < walk.size(); ++k) {
     s.arrival[k] = static_cast<int>(s.steps.size());
-    const HH h_in =
-        mesh.find_halfedge(mesh.vertex_handle(walk[k - 1]), mesh.vertex_handle(walk[k]));
     const HH h_out =
         mesh.find_halfedge(mesh.vertex_handle(walk[k]), mesh.vertex_handle(walk[k + 1]));
     if (mesh.is_boundary(h_out)) return false;
@@ -38,6 +37,7 @@ bool left_strip(const TriMesh& mesh, const std::vector<int>& walk, ArcStrip& s) 
       s.steps.push_back(o);
       o = mesh.next_halfedge_handle(opp);
     }
+    h_in = h_out;
   }
   s.arrival.back() = static_cast<int>(s.steps.size());
   return true;
@@ -151,17 +151,18 @@ Labeling label_layout(const TriMesh& mesh, const GeometryCache& g, const Layout&
       throw QsError("internal error: half-arc " + std::to_string(h) + " not reached by labelling");
 
   // Global choice: the offset that best matches the geometry of all half-arcs.
+  std::vector<double> angle(2 * na);
+  for (int h = 0; h < 2 * na; ++h) angle[h] = geometric_angle(h);
   int best = 0;
   double best_score = -1e300;
   for (int d0 = 0; d0 < 4; ++d0) {
     double score = 0;
-    for (int h = 0; h < 2 * na; ++h)
-      score += std::cos(geometric_angle(h) - (rel[h] + d0) * M_PI / 2);
+    for (int h = 0; h < 2 * na; ++h) score += std::cos(angle[h] - (rel[h] + d0) * M_PI / 2);
     if (score > best_score) best_score = score, best = d0;
   }
   for (int h = 0; h < 2 * na; ++h) {
     L.symbol[h] = mod4(rel[h] + best);
-    const int geometric = mod4(static_cast<int>(std::lround(geometric_angle(h) / (M_PI / 2))));
+    const int geometric = mod4(static_cast<int>(std::lround(angle[h] / (M_PI / 2))));
     L.geometric_mismatches += geometric != L.symbol[h];
   }
   for (int a = 0; a < na; ++a) L.iso_u[a] = L.symbol[2 * a] % 2 == 1;

@@ -105,6 +105,26 @@ void face_gradients(const TriMesh& mesh, const GeometryCache& g, int f,
 
 }  // namespace
 
+std::vector<int> parameterization_groups(int wedges, const std::vector<int>& free_index, int free) {
+  std::vector<int> group(free, -1);
+  std::vector<int> wedge_group(wedges, -1);
+  int groups = 0;
+  for (int i = 0; i < static_cast<int>(free_index.size()); ++i) {
+    const int k = free_index[i];
+    if (k < 0 || k >= free) continue;
+    if (i < 2 * wedges) {
+      int& g = wedge_group[i / 2];
+      if (g < 0) g = groups++;
+      group[k] = g;
+    } else {
+      group[k] = groups++;
+    }
+  }
+  for (int& g : group)
+    if (g < 0) g = groups++;  // not named by free_index (does not happen for a Reduction)
+  return group;
+}
+
 double param_signed_area2(const std::vector<std::array<double, 2>>& uv, int f) {
   const auto& a = uv[3 * f];
   const auto& b = uv[3 * f + 1];
@@ -372,6 +392,12 @@ std::vector<ArcLength> ParamSolver::arc_lengths() const {
   return out;
 }
 
+void ParamSolver::hint_ordering(const Eigen::SparseMatrix<double>& A) {
+  if (!options_.wedge_ordering || solver_.same_pattern(A)) return;
+  solver_.set_ordering_hint(grouped_amd_ordering(
+      A, parameterization_groups(cut_.wedges, reduction_.free_index, static_cast<int>(A.cols()))));
+}
+
 std::vector<double> ParamSolver::target_scales(const TriMesh& mesh, const GeometryCache& g,
                                                const std::vector<double>& theta) {
   std::vector<double> scale(g.n_faces, 1.0);
@@ -439,6 +465,7 @@ const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCa
                                 : Eigen::VectorXd(Z.transpose() * (rhs - H * reduction_.z0));
   result_.timings.assemble_s = seconds_since(t0);
   t0 = std::chrono::steady_clock::now();
+  hint_ordering(A);
   solver_.factorize(A);
   result_.timings.factorize_s = solver_.stats().factorize_s;
   result_.timings.analyze_s = solver_.stats().analyze_s;
@@ -468,7 +495,7 @@ const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCa
     }
   }
   const Eigen::VectorXd x = Z * y + reduction_.z0;
-  result_.energy = energy_of(y);
+  result_.energy = std::max(0.0, x.dot(H * x) - 2 * rhs.dot(x) + constant);  // energy_of(y)
   result_.corner_uv.resize(3 * g.n_faces);
   result_.foldovers = 0;
   for (int f = 0; f < g.n_faces; ++f) {
@@ -521,6 +548,7 @@ double ParamSolver::optimal_field_rotation(const TriMesh& mesh, const GeometryCa
   B.col(0) = Z.transpose() * rhs0;
   B.col(1) = Z.transpose() * rhs1;
   B.col(2) = -(Z.transpose() * Hz0);
+  hint_ordering(A);
   solver_.factorize(A);
   const Eigen::MatrixXd Y = solver_.solve(B);
   Eigen::Matrix3d M = B.transpose() * Y;

@@ -15,65 +15,85 @@ ReducedAssembly::ReducedAssembly(const std::vector<int>& corner_wedge, int wedge
   for (int w : corner_wedge)
     if (w < 0 || w >= wedges) throw QsError("internal error: corner wedge out of range");
 
-  // Wedges sharing a face (each wedge with itself), as sorted lists (CSR).
-  std::vector<int> nbr_outer(wedges + 1, 0);
-  for (int w : corner_wedge) nbr_outer[w + 1] += 3;
-  for (int w = 0; w < wedges; ++w) nbr_outer[w + 1] += nbr_outer[w];
-  std::vector<int> nbr(nbr_outer[wedges]);
+  // Per wedge w (sequentially, so the writes to H's pattern are sequential): the wedges
+  // sharing a face with it (itself included), sorted, give H's columns 2w (rows 2w', u) and
+  // 2w + 1 (rows 2w' + 1, v); the slots of w's corners' face blocks follow from the positions.
+  std::vector<int> wc_start(wedges + 1, 0), wc(corner_wedge.size());
+  for (int w : corner_wedge) ++wc_start[w + 1];
+  for (int w = 0; w < wedges; ++w) wc_start[w + 1] += wc_start[w];
   {
-    std::vector<int> next(nbr_outer.begin(), nbr_outer.end() - 1);
-    for (int f = 0; f < nf; ++f)
-      for (int k = 0; k < 3; ++k)
-        for (int l = 0; l < 3; ++l) nbr[next[corner_wedge[3 * f + k]]++] = corner_wedge[3 * f + l];
-    int out = 0;
-    for (int w = 0; w < wedges; ++w) {
-      const auto b = nbr.begin() + nbr_outer[w], e = nbr.begin() + nbr_outer[w + 1];
-      std::sort(b, e);
-      const int len = static_cast<int>(std::unique(b, e) - b);
-      std::copy(b, b + len, nbr.begin() + out);
-      nbr_outer[w] = out;
-      out += len;
-    }
-    nbr_outer[wedges] = out;
-    nbr.resize(out);
+    std::vector<int> next(wc_start.begin(), wc_start.end() - 1);
+    for (int c = 0; c < 3 * nf; ++c) wc[next[corner_wedge[c]]++] = c;
   }
-  // H: column 2w + c holds the rows 2w' + c, w' ∈ nbr(w), c = 0 (u) or 1 (v).
-  H_.resize(n, n);
-  H_.resizeNonZeros(static_cast<Eigen::Index>(2 * nbr.size()));
-  {
-    int* outer = H_.outerIndexPtr();
-    int* inner = H_.innerIndexPtr();
-    int pos = 0;
-    for (int col = 0; col < n; ++col) {
-      outer[col] = pos;
-      if (col < 2 * wedges)
-        for (int q = nbr_outer[col / 2]; q < nbr_outer[col / 2 + 1]; ++q)
-          inner[pos++] = 2 * nbr[q] + col % 2;
-    }
-    outer[n] = pos;
-    std::fill(H_.valuePtr(), H_.valuePtr() + H_.nonZeros(), 0.0);
-  }
+  std::vector<int> hp(n + 1, 0), hi;
+  hi.reserve(static_cast<size_t>(16) * wedges);
   face_slot_.resize(18 * static_cast<size_t>(nf));
-  for (int f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k)
-      for (int l = 0; l < 3; ++l) {
-        const int wk = corner_wedge[3 * f + k], wl = corner_wedge[3 * f + l];
-        const int p = static_cast<int>(
-            std::lower_bound(nbr.begin() + nbr_outer[wl], nbr.begin() + nbr_outer[wl + 1], wk) -
-            (nbr.begin() + nbr_outer[wl]));
-        face_slot_[18 * f + 3 * k + l] = H_.outerIndexPtr()[2 * wl] + p;
-        face_slot_[18 * f + 9 + 3 * k + l] = H_.outerIndexPtr()[2 * wl + 1] + p;
+  {
+    std::vector<int> mark(wedges, -1), pos(wedges, 0), list;
+    for (int w = 0; w < wedges; ++w) {
+      list.clear();
+      for (int q = wc_start[w]; q < wc_start[w + 1]; ++q) {
+        const int* fw = &corner_wedge[3 * (wc[q] / 3)];
+        for (int k = 0; k < 3; ++k)
+          if (mark[fw[k]] != w) {
+            mark[fw[k]] = w;
+            list.push_back(fw[k]);
+          }
       }
+      for (size_t i = 1; i < list.size(); ++i) {  // insertion sort: a handful of wedges
+        const int x = list[i];
+        size_t j = i;
+        for (; j > 0 && list[j - 1] > x; --j) list[j] = list[j - 1];
+        list[j] = x;
+      }
+      const int len = static_cast<int>(list.size());
+      const int base = static_cast<int>(hi.size());
+      hp[2 * w] = base;
+      hp[2 * w + 1] = base + len;
+      for (int i = 0; i < len; ++i) {
+        pos[list[i]] = i;
+        hi.push_back(2 * list[i]);
+      }
+      for (int i = 0; i < len; ++i) hi.push_back(2 * list[i] + 1);
+      for (int q = wc_start[w]; q < wc_start[w + 1]; ++q) {
+        const int f = wc[q] / 3, l = wc[q] % 3;
+        int* slot = &face_slot_[18 * static_cast<size_t>(f)];
+        for (int k = 0; k < 3; ++k) {
+          const int p = pos[corner_wedge[3 * f + k]];
+          slot[3 * k + l] = base + p;
+          slot[9 + 3 * k + l] = base + len + p;
+        }
+      }
+    }
+    for (int col = 2 * wedges; col <= n; ++col) hp[col] = static_cast<int>(hi.size());
+  }
+  H_.resize(n, n);
+  H_.resizeNonZeros(static_cast<Eigen::Index>(hi.size()));
+  std::copy(hp.begin(), hp.end(), H_.outerIndexPtr());
+  std::copy(hi.begin(), hi.end(), H_.innerIndexPtr());
+  std::fill(H_.valuePtr(), H_.valuePtr() + H_.nonZeros(), 0.0);
 
   // Z by columns and rows; dense columns D.
   const int m = static_cast<int>(Z.cols());
   Z_ = Z;
   Z_.makeCompressed();
-  {
-    const Eigen::SparseMatrix<double, Eigen::RowMajor> Zr = Z_;
-    zr_outer_.assign(Zr.outerIndexPtr(), Zr.outerIndexPtr() + n + 1);
-    zr_col_.assign(Zr.innerIndexPtr(), Zr.innerIndexPtr() + Zr.nonZeros());
-    zr_val_.assign(Zr.valuePtr(), Zr.valuePtr() + Zr.nonZeros());
+  {  // Z by rows (a counting-sort transpose: columns increase within every row)
+    const int* zo = Z_.outerIndexPtr();
+    const int* zi = Z_.innerIndexPtr();
+    const double* zv = Z_.valuePtr();
+    const int nz = static_cast<int>(Z_.nonZeros());
+    zr_outer_.assign(n + 1, 0);
+    for (int q = 0; q < nz; ++q) ++zr_outer_[zi[q] + 1];
+    for (int i = 0; i < n; ++i) zr_outer_[i + 1] += zr_outer_[i];
+    zr_col_.resize(nz);
+    zr_val_.resize(nz);
+    std::vector<int> next(zr_outer_.begin(), zr_outer_.end() - 1);
+    for (int b = 0; b < m; ++b)
+      for (int q = zo[b]; q < zo[b + 1]; ++q) {
+        const int at = next[zi[q]]++;
+        zr_col_[at] = b;
+        zr_val_[at] = zv[q];
+      }
   }
   const double dense_threshold = std::max(32.0, std::sqrt(static_cast<double>(m)));
   dense_pos_.assign(m, -1);
@@ -87,6 +107,8 @@ ReducedAssembly::ReducedAssembly(const std::vector<int>& corner_wedge, int wedge
   s_outer_.assign(n + 1, 0);
   t_outer_.assign(n + 1, 0);
   s_col_.clear(), s_val_.clear(), t_dense_.clear(), t_val_.clear(), t_rows_.clear();
+  s_col_.reserve(zr_col_.size());
+  s_val_.reserve(zr_col_.size());
   for (int i = 0; i < n; ++i) {
     for (int q = zr_outer_[i]; q < zr_outer_[i + 1]; ++q) {
       const int p = dense_pos_[zr_col_[q]];
@@ -127,11 +149,13 @@ ReducedAssembly::ReducedAssembly(const std::vector<int>& corner_wedge, int wedge
   c_.assign(static_cast<size_t>(c_rows_) * d_, 0.0);
 
   // Lower triangle of A (row ≥ column) with the source of every entry.
+  constexpr int A_reserve_factor = 8;  // lower entries per column, a guess (grows if needed)
   lower_outer_.assign(m + 1, 0);
   lower_rows_.clear();
   lower_src_.clear();
-  std::vector<int> mark(m, -1);
-  std::vector<std::pair<int, int>> column, merged;  // (row, source)
+  lower_rows_.reserve(static_cast<size_t>(A_reserve_factor) * m);
+  lower_src_.reserve(static_cast<size_t>(A_reserve_factor) * m);
+  std::vector<int> mark(m, -1), column;
   flops_ = 0;
   for (int b = 0; b < m; ++b) {
     column.clear();
@@ -147,31 +171,43 @@ ReducedAssembly::ReducedAssembly(const std::vector<int>& corner_wedge, int wedge
             ++flops_;
             if (mark[a] != b) {
               mark[a] = b;
-              column.push_back({a, -1});
+              column.push_back(a);
             }
           }
         }
       }
-      std::sort(column.begin(), column.end());
-      if (c_index_[b] >= 0) {  // A(d, b) = A(b, d) = C(b, d) for dense columns d > b (sorted)
-        merged.clear();
-        size_t q = 0;
+      if (column.size() <= 32) {  // insertion sort: columns hold a few dozen rows
+        for (size_t i = 1; i < column.size(); ++i) {
+          const int x = column[i];
+          size_t j = i;
+          for (; j > 0 && column[j - 1] > x; --j) column[j] = column[j - 1];
+          column[j] = x;
+        }
+      } else {
+        std::sort(column.begin(), column.end());
+      }
+      // A(d, b) = A(b, d) = C(b, d) for the dense columns d > b, merged in (both sorted).
+      size_t q = 0;
+      if (c_index_[b] >= 0)
         for (int p = 0; p < d_; ++p) {
           if (dense_cols[p] <= b) continue;
-          while (q < column.size() && column[q].first < dense_cols[p])
-            merged.push_back(column[q++]);
-          merged.push_back({dense_cols[p], c_index_[b] * d_ + p});
+          for (; q < column.size() && column[q] < dense_cols[p]; ++q) {
+            lower_rows_.push_back(column[q]);
+            lower_src_.push_back(-1);
+          }
+          lower_rows_.push_back(dense_cols[p]);
+          lower_src_.push_back(c_index_[b] * d_ + p);
         }
-        merged.insert(merged.end(), column.begin() + static_cast<long>(q), column.end());
-        column.swap(merged);
+      for (; q < column.size(); ++q) {
+        lower_rows_.push_back(column[q]);
+        lower_src_.push_back(-1);
       }
     } else {
       for (int a : c_list)  // sorted
-        if (a >= b) column.push_back({a, c_index_[a] * d_ + pb});
-    }
-    for (const auto& [a, src] : column) {
-      lower_rows_.push_back(a);
-      lower_src_.push_back(src);
+        if (a >= b) {
+          lower_rows_.push_back(a);
+          lower_src_.push_back(c_index_[a] * d_ + pb);
+        }
     }
     lower_outer_[b + 1] = static_cast<int>(lower_rows_.size());
   }

@@ -18,6 +18,24 @@
 
 namespace qs {
 
+namespace detail {
+//! A SparseMatrix that moves by swapping: Eigen 3.4.0's SparseMatrix has no move operations,
+//! so moving a class that holds one copies it.
+class MovableSparse : public Eigen::SparseMatrix<double> {
+ public:
+  using Base = Eigen::SparseMatrix<double>;
+  using Base::operator=;
+  MovableSparse() = default;
+  MovableSparse(const MovableSparse&) = default;
+  MovableSparse& operator=(const MovableSparse&) = default;
+  MovableSparse(MovableSparse&& other) noexcept { swap(other); }
+  MovableSparse& operator=(MovableSparse&& other) noexcept {
+    swap(other);
+    return *this;
+  }
+};
+}  // namespace detail
+
 class ReducedAssembly {
  public:
   ReducedAssembly() = default;
@@ -53,12 +71,12 @@ class ReducedAssembly {
   long reduce_flops() const { return flops_; }
 
  private:
-  Eigen::SparseMatrix<double> H_;
-  Eigen::SparseMatrix<double> A_;
+  detail::MovableSparse H_;
+  detail::MovableSparse A_;
   std::vector<int>
       face_slot_;  // per face 18 slots into H_: (k, l) of u at 3k + l, of v at 9 + 3k + l
   // Z by columns and by rows, entries split into S (column not dense) and T (dense column).
-  Eigen::SparseMatrix<double> Z_;
+  detail::MovableSparse Z_;
   std::vector<int> zr_outer_, zr_col_;  // Z by rows (all entries)
   std::vector<double> zr_val_;
   std::vector<int> s_outer_, s_col_;  // S by rows
