@@ -1,11 +1,12 @@
 // Node-optimization step cost (issue #5): per-step time of optimize_nodes against one
 // parameterization factorization + solve measured in the same process. Not a test.
 //
-//   qs_nodeopt_bench MESH LAYOUT [STEPS=10] [REPEATS=3] [descent] [fresh] [steps]
+//   qs_nodeopt_bench MESH LAYOUT [STEPS=10] [REPEATS=3] [descent] [fresh] [parallel] [steps]
 //
 // descent: no hop polish and no fold-over removal after the descent (only the STEPS descent
 // steps are timed in "optimize"); fresh: NodeOptOptions::reuse_field off (a fresh Pipeline per
-// trial with re-routed arcs, the behaviour before session 3); steps: print every step.
+// trial with re-routed arcs, the behaviour before session 3); parallel:
+// NodeOptOptions::parallel_retry on (two threads); steps: print every step.
 // Times are CPU seconds of the process (CLOCK_PROCESS_CPUTIME_ID: wall time is meaningless
 // on a shared, overloaded machine); run with OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
 // OMP_THREAD_LIMIT=1 so that no spinning helper thread is counted (Debian's CHOLMOD asks for 4
@@ -19,6 +20,7 @@
 #include <time.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -60,7 +62,10 @@ using qs::bench::median;
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::fprintf(stderr, "usage: %s MESH LAYOUT [STEPS=10] [REPEATS=3]\n", argv[0]);
+    std::fprintf(
+        stderr,
+        "usage: %s MESH LAYOUT [STEPS=10] [REPEATS=3] [descent] [fresh] [parallel] [steps]\n",
+        argv[0]);
     return 2;
   }
   // The library's own thread limit (core/base/solver_threads.h, default 2) resizes OpenBLAS's
@@ -76,10 +81,11 @@ int main(int argc, char** argv) {
     // Flags after REPEATS: "descent" (no hop polish, no fold-over removal at the end), "fresh"
     // (NodeOptOptions::reuse_field off: a fresh Pipeline per trial with re-routed arcs).
     // "steps": print every step.
-    bool descent_only = false, fresh_trials = false, verbose = false;
+    bool descent_only = false, fresh_trials = false, verbose = false, parallel = false;
     for (int k = 5; k < argc; ++k) {
       descent_only |= std::string(argv[k]) == "descent";
       fresh_trials |= std::string(argv[k]) == "fresh";
+      parallel |= std::string(argv[k]) == "parallel";
       verbose |= std::string(argv[k]) == "steps";
     }
     const qs::PipelineOptions options;
@@ -99,6 +105,7 @@ int main(int argc, char** argv) {
       qs::NodeOptOptions no;
       no.max_steps = steps;
       no.reuse_field = !fresh_trials;
+      no.parallel_retry = parallel;
       if (descent_only) {
         no.hop_polish = false;
         no.orientation_at_end = false;
@@ -108,18 +115,22 @@ int main(int argc, char** argv) {
       StepTimer timer;
       timer.verbose = verbose;
       t0 = timer.last = cpu_now();
+      const auto wall0 = std::chrono::steady_clock::now();
       const qs::NodeOptResult r =
           qs::optimize_nodes(mesh, layout, options, no, &timer, nullptr, &stats);
       total.push_back(cpu_now() - t0);
+      const double wall =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
       step.push_back(median(timer.descent));
       ratio.push_back(step.back() / resolve.back());
       std::printf(
           "repeat %d: fresh pipeline %.3f s, param re-solve %.3f s, median step %.3f s "
-          "(%.1fx), optimize %.3f s, steps %d (accepted %d), E %.6g -> %.6g, fresh pipelines "
-          "%d, relayouts %d, reused solves %d, gradient reuses %d, tabu steps %d\n",
-          rep, fresh.back(), resolve.back(), step.back(), ratio.back(), total.back(), r.steps,
+          "(%.1fx), optimize %.3f s CPU (%.3f s wall), steps %d (accepted %d), E %.6g -> %.6g, "
+          "fresh pipelines %d, relayouts %d (%d beside their retry), reused solves %d, "
+          "gradient reuses %d, tabu steps %d\n",
+          rep, fresh.back(), resolve.back(), step.back(), ratio.back(), total.back(), wall, r.steps,
           r.accepted, r.E_init, r.E_final, stats.fresh_pipelines, stats.relayouts,
-          stats.reused_solves, stats.gradient_reuses, stats.tabu_steps);
+          stats.parallel_retries, stats.reused_solves, stats.gradient_reuses, stats.tabu_steps);
     }
     std::printf(
         "median: faces %zu, nodes %zu, fresh pipeline %.3f s, param re-solve %.3f s, median "

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <queue>
+#include <thread>
 
 #include "core/layout/base_complex.h"
 #include "core/layout/layout_io.h"
@@ -980,6 +981,34 @@ TEST(NodeOptimizer, HopPolishReturnsPolycubeNodesToCorners) {
     const auto vh = r.mesh.vertex_handle(v);
     EXPECT_EQ(r.mesh.point(vh), poly.mesh.point(vh)) << "node " << n << " relocated";
   }
+}
+
+// parallel_retry solves a re-layout on a second thread beside its retry without switches: the
+// same trajectory as the sequential order, step for step.
+TEST(NodeOptimizer, ParallelRetryGivesTheSequentialTrajectory) {
+  const std::string dir = std::string(QS_ASSETS_DIR) + "/example/";
+  const TriMesh mesh = load_mesh(dir + "ellipsoid.obj");
+  const Layout layout = load_layout(dir + "ellipsoid.layout.json", mesh);
+  NodeOptOptions sequential, parallel;
+  sequential.orientation_at_end = parallel.orientation_at_end = false;
+  sequential.stiffen_at_end = parallel.stiffen_at_end = false;
+  parallel.parallel_retry = true;
+  NodeOptStats s_seq, s_par;
+  const NodeOptResult a =
+      optimize_nodes(mesh, layout, PipelineOptions{}, sequential, nullptr, nullptr, &s_seq);
+  const NodeOptResult b =
+      optimize_nodes(mesh, layout, PipelineOptions{}, parallel, nullptr, nullptr, &s_par);
+  EXPECT_EQ(s_seq.parallel_retries, 0);
+  if (std::thread::hardware_concurrency() >= 2) EXPECT_GT(s_par.parallel_retries, 0);
+  ASSERT_EQ(a.reports.size(), b.reports.size());
+  for (size_t k = 0; k < a.reports.size(); ++k) {
+    EXPECT_EQ(a.reports[k].accepted, b.reports[k].accepted) << "step " << k;
+    EXPECT_NEAR(a.reports[k].E, b.reports[k].E, 1e-12 * a.reports[k].E) << "step " << k;
+  }
+  EXPECT_NEAR(a.E_descent, b.E_descent, 1e-12 * a.E_descent);
+  EXPECT_EQ(a.layout.nodes.size(), b.layout.nodes.size());
+  for (size_t n = 0; n < a.layout.nodes.size(); ++n)
+    EXPECT_EQ(a.layout.nodes[n].vertex, b.layout.nodes[n].vertex);
 }
 
 }  // namespace

@@ -560,6 +560,10 @@ const CrossField& CrossFieldSolver::update_layout(const TriMesh& mesh, const Geo
   return field_;
 }
 
+void CrossFieldSolver::unshare_solvers() {
+  for (SpdSolver* s : {&solver_, &spare_, &reference_, &full_}) s->unshare();
+}
+
 void CrossFieldSolver::rotate(double phi) {
   for (double& t : field_.theta) t += phi;
   if (field_.gauge_face >= 0) gauge_angle_ += phi;

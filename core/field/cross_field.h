@@ -123,6 +123,9 @@ class CrossFieldSolver {
   const CrossField& update_layout(const TriMesh& mesh, const GeometryCache& geometry,
                                   const Layout& layout, const LayoutTopology& topology);
   const CrossField& field() const { return field_; }
+  //! Gives every factorization shared with another copy of this solver its own CHOLMOD factor
+  //! (numeric values included): the copies can then be solved on different threads.
+  void unshare_solvers();
   //! Rotates the whole field by φ (radians) — meaningful only when it has no direction
   //! constraints (its global rotation is then free); later re-solves keep the rotation.
   void rotate(double phi);

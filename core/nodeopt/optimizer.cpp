@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <memory>
+#include <thread>
 
 #include "core/base/timing.h"
 #include "core/nodeopt/discrete.h"
@@ -494,23 +496,72 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     const bool repeated =
         no.switch_tabu && n_switched > 0 && n_repeated >= no.switch_tabu_overlap * n_switched;
     counters.tabu_steps += repeated;
-    bool ok = !repeated && try_evaluate(trial, switched, next);
-    if (!repeated && std::find(switched.begin(), switched.end(), 1) != switched.end())
+    // The retry without switches (below) does not depend on the re-layout's result: with
+    // parallel_retry it is solved on this thread while the re-layout is solved on another.
+    State retry;
+    std::vector<char> retry_switched;
+    bool retry_built = false;
+    Evaluation second;
+    bool second_ok = false;
+    bool ok = false;
+    const bool retry_possible = no.retry_without_switches && n_switched > 0 && !repeated;
+    if (retry_possible && no.parallel_retry && no.reuse_field && current.pipeline->field() &&
+        std::thread::hardware_concurrency() >= 2) {
+      retry_built = true;
+      const bool retry_moves = build_trial(switched, retry, retry_switched) > 0;
+      const bool retry_reuses =
+          std::find(retry_switched.begin(), retry_switched.end(), 1) == retry_switched.end();
+      if (retry_moves && retry_reuses) {
+        check_cancel(observer);
+        // The continued Pipeline is built here (it copies the current one, which the retry
+        // re-solves in place) and owns its factorizations before the other thread starts.
+        std::shared_ptr<Pipeline> p;
+        try {
+          p = std::make_shared<Pipeline>(trial.mesh, trial.layout, *current.pipeline);
+          p->unshare_solvers();
+        } catch (const QsError&) {
+          p.reset();
+        }
+        if (p) {
+          ++counters.relayouts;
+          ++counters.parallel_retries;
+          auto first = std::async(std::launch::async, [p, &options]() {
+            Evaluation ev;
+            ev.pipeline = p;
+            solve_and_measure(ev, options);
+            return ev;
+          });
+          second_ok = try_evaluate(retry, retry_switched, second);  // waits for first if it throws
+          try {
+            next = first.get();
+            ok = true;
+          } catch (const QsError&) {
+            ok = false;  // e.g. a layout the field cannot realize: treat like an increase
+          }
+        } else {
+          ok = false;
+          second_ok = try_evaluate(retry, retry_switched, second);
+        }
+      } else {
+        ok = try_evaluate(trial, switched, next);
+        if (!(ok && next.E <= current.E) && retry_moves)
+          second_ok = try_evaluate(retry, retry_switched, second);
+      }
+    } else {
+      ok = !repeated && try_evaluate(trial, switched, next);
+    }
+    if (!repeated && n_switched > 0)
       rejected_target =
           ok && next.E <= current.E ? std::vector<int>(movable.size(), -1) : first_target;
     // A node that changed its vertex can raise E discontinuously: retry once with those nodes
     // kept on their vertices before halving α.
-    if (no.retry_without_switches && !(ok && next.E <= current.E) &&
-        std::find(switched.begin(), switched.end(), 1) != switched.end()) {
-      State retry;
-      std::vector<char> retry_switched;
-      if (build_trial(switched, retry, retry_switched) > 0) {
-        Evaluation second;
-        if (try_evaluate(retry, retry_switched, second) && second.E <= current.E) {
-          trial = std::move(retry);
-          next = std::move(second);
-          ok = true;
-        }
+    if (no.retry_without_switches && !(ok && next.E <= current.E) && n_switched > 0) {
+      if (!retry_built && build_trial(switched, retry, retry_switched) > 0)
+        second_ok = try_evaluate(retry, retry_switched, second);
+      if (second_ok && second.E <= current.E) {
+        trial = std::move(retry);
+        next = std::move(second);
+        ok = true;
       }
     }
     r.accepted = ok && next.E <= current.E;

@@ -54,6 +54,10 @@ void Pipeline::update_positions(const TriMesh& mesh) {
   extraction_.reset();
 }
 
+void Pipeline::unshare_solvers() {
+  if (field_solver_) field_solver_->unshare_solvers();
+}
+
 const CrossField& Pipeline::compute_field() {
   if (!field_solver_) {
     field_solver_ =

@@ -65,6 +65,10 @@ class Pipeline {
   //! and factorization patterns do not depend on positions); call compute_parameterization()
   //! to re-solve. \throw InvalidInputError when the vertex or face count differs.
   void update_positions(const TriMesh& mesh);
+  //! Gives this Pipeline its own copy of every factorization it shares with the Pipeline it
+  //! was continued from (copies share them until one side factorizes): afterwards the two can
+  //! be solved on different threads at the same time.
+  void unshare_solvers();
 
   //! Computes (or re-solves) the cross field. \throw TopologyError, SolverError.
   const CrossField& compute_field();
