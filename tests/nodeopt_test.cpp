@@ -843,22 +843,25 @@ TEST(NodeOptimizer, ReuseMatchesFreshPipelinesOnExample) {
   }
 }
 
+// The bundled example optimized with \p no, without fold-over removal after the descent.
+NodeOptResult optimize_example(NodeOptOptions no, NodeOptStats* stats) {
+  const std::string dir = std::string(QS_ASSETS_DIR) + "/example/";
+  const TriMesh mesh = load_mesh(dir + "ellipsoid.obj");
+  const Layout layout = load_layout(dir + "ellipsoid.layout.json", mesh);
+  no.orientation_at_end = false;
+  no.stiffen_at_end = false;
+  return optimize_nodes(mesh, layout, PipelineOptions{}, no, nullptr, nullptr, stats);
+}
+
 // The switch tabu (NodeOptOptions::switch_tabu) rejects trials that mostly repeat the switches
 // of one rejected at the same α without solving them: on the bundled example it skips such
 // trials, so fewer re-layouts are solved, and the descent still ends at least as low.
 TEST(NodeOptimizer, SwitchTabuSkipsRepeatedRejectedSwitches) {
-  const std::string dir = std::string(QS_ASSETS_DIR) + "/example/";
-  const TriMesh mesh = load_mesh(dir + "ellipsoid.obj");
-  const Layout layout = load_layout(dir + "ellipsoid.layout.json", mesh);
-  NodeOptOptions with, without;
-  with.orientation_at_end = without.orientation_at_end = false;
-  with.stiffen_at_end = without.stiffen_at_end = false;
+  NodeOptOptions without;
   without.switch_tabu = false;
   NodeOptStats s_with, s_without;
-  const NodeOptResult r_with =
-      optimize_nodes(mesh, layout, PipelineOptions{}, with, nullptr, nullptr, &s_with);
-  const NodeOptResult r_without =
-      optimize_nodes(mesh, layout, PipelineOptions{}, without, nullptr, nullptr, &s_without);
+  const NodeOptResult r_with = optimize_example(NodeOptOptions{}, &s_with);
+  const NodeOptResult r_without = optimize_example(without, &s_without);
   std::printf("[stat] example: tabu %d skipped trials, re-layouts %d vs %d, E %.9g vs %.9g\n",
               s_with.tabu_steps, s_with.relayouts, s_without.relayouts, r_with.E_descent,
               r_without.E_descent);
@@ -986,18 +989,11 @@ TEST(NodeOptimizer, HopPolishReturnsPolycubeNodesToCorners) {
 // parallel_retry solves a re-layout on a second thread beside its retry without switches: the
 // same trajectory as the sequential order, step for step.
 TEST(NodeOptimizer, ParallelRetryGivesTheSequentialTrajectory) {
-  const std::string dir = std::string(QS_ASSETS_DIR) + "/example/";
-  const TriMesh mesh = load_mesh(dir + "ellipsoid.obj");
-  const Layout layout = load_layout(dir + "ellipsoid.layout.json", mesh);
-  NodeOptOptions sequential, parallel;
-  sequential.orientation_at_end = parallel.orientation_at_end = false;
-  sequential.stiffen_at_end = parallel.stiffen_at_end = false;
+  NodeOptOptions parallel;
   parallel.parallel_retry = true;
   NodeOptStats s_seq, s_par;
-  const NodeOptResult a =
-      optimize_nodes(mesh, layout, PipelineOptions{}, sequential, nullptr, nullptr, &s_seq);
-  const NodeOptResult b =
-      optimize_nodes(mesh, layout, PipelineOptions{}, parallel, nullptr, nullptr, &s_par);
+  const NodeOptResult a = optimize_example(NodeOptOptions{}, &s_seq);
+  const NodeOptResult b = optimize_example(parallel, &s_par);
   EXPECT_EQ(s_seq.parallel_retries, 0);
   if (std::thread::hardware_concurrency() >= 2) EXPECT_GT(s_par.parallel_retries, 0);
   ASSERT_EQ(a.reports.size(), b.reports.size());

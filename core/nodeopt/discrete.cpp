@@ -138,25 +138,29 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
     int best_vertex = -1;
     double best_E = result.E;
     int best_foldovers = result.foldovers;
-    if (o.try_restore && mesh.point(mesh.vertex_handle(v)) != restored &&
-        result.evaluations < o.max_evaluations &&
-        relocation_keeps_orientation(mesh, original, -1, v, restored, o.relocation)) {
+    // One solve: node n on vertex w (\p trial's routing) with v at its original position; a
+    // failed solve counts as one without a lower E.
+    auto try_vertex = [&](Layout trial, int w) {
       check_cancel(observer);
       TriMesh moved = mesh;
       moved.set_point(moved.vertex_handle(v), restored);
       ++result.evaluations;
       double trial_E = 0;
       int trial_foldovers = 0;
-      if (evaluate(moved, layout, trial_E, trial_foldovers) && trial_E < best_E) {
+      if (evaluate(moved, trial, trial_E, trial_foldovers) && trial_E < best_E) {
         best_E = trial_E;
         best_foldovers = trial_foldovers;
-        best_layout = layout;
-        best_vertex = v;
+        best_layout = std::move(trial);
+        best_vertex = w;
         failures = 0;
       } else {
         ++failures;
       }
-    }
+    };
+    if (o.try_restore && mesh.point(mesh.vertex_handle(v)) != restored &&
+        result.evaluations < o.max_evaluations &&
+        relocation_keeps_orientation(mesh, original, -1, v, restored, o.relocation))
+      try_vertex(layout, v);
     std::vector<int> candidates;
     if (!o.targets.empty()) {
       const std::vector<char> forbidden = forbidden_relocation_vertices(original, layout, n);
@@ -172,22 +176,7 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
       if (!relocation_keeps_orientation(mesh, original, v, w, at, o.relocation)) continue;
       Layout trial = layout;
       if (!move_node_and_reroute(mesh, trial, n, w, o.relocation, context)) continue;
-      check_cancel(observer);
-      TriMesh moved = mesh;
-      moved.set_point(moved.vertex_handle(v), restored);
-      ++result.evaluations;
-      double trial_E = 0;
-      int trial_foldovers = 0;
-      if (!evaluate(moved, trial, trial_E, trial_foldovers)) continue;
-      if (trial_E < best_E) {
-        best_E = trial_E;
-        best_foldovers = trial_foldovers;
-        best_layout = std::move(trial);
-        best_vertex = w;
-        failures = 0;
-      } else {
-        ++failures;
-      }
+      try_vertex(std::move(trial), w);
       if (o.max_failures > 0 && failures >= o.max_failures) break;
     }
     if (best_vertex >= 0) {
