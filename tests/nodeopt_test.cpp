@@ -897,7 +897,7 @@ std::vector<int> node_valences(const Layout& layout) {
 // smooth mesh has no candidates.
 TEST(DiscreteRelocation, ConeCandidatesFindPolycubeCorners) {
   const auto poly = test::genus2_polycube(4);
-  const std::vector<double> deficit = vertex_angle_deficits(poly.mesh);
+  const std::vector<double> deficit = vertex_angle_deficits(build_geometry(poly.mesh));
   double total = 0;
   for (double d : deficit) total += d;
   EXPECT_NEAR(total, -4 * M_PI, 1e-9);
@@ -942,7 +942,7 @@ TEST(DiscreteRelocation, ConeCandidatesFindPolycubeCorners) {
   EXPECT_TRUE(snap.hop_nodes.empty());
 
   const auto smooth = test::cube_sphere(8, Vec3(1.3, 1, 0.75));
-  const std::vector<double> smooth_deficit = vertex_angle_deficits(smooth.mesh);
+  const std::vector<double> smooth_deficit = vertex_angle_deficits(build_geometry(smooth.mesh));
   const Layout smooth_displaced = qs::perturb_layout(smooth.mesh, smooth.layout, po).layout;
   std::vector<int> smooth_all(smooth.layout.nodes.size());
   for (size_t n = 0; n < smooth_all.size(); ++n) smooth_all[n] = static_cast<int>(n);
@@ -958,7 +958,7 @@ TEST(DiscreteRelocation, ConeCandidatesFindPolycubeCorners) {
 // those passes the run ends far higher.
 TEST(NodeOptimizer, HopPolishReturnsPolycubeNodesToCorners) {
   const auto poly = test::genus2_polycube(4);
-  const std::vector<double> deficit = vertex_angle_deficits(poly.mesh);
+  const std::vector<double> deficit = vertex_angle_deficits(build_geometry(poly.mesh));
   PerturbLayoutOptions po;
   po.rings = 1;
   po.seed = 1;

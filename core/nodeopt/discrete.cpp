@@ -41,20 +41,10 @@ std::vector<int> hop_candidates(const TriMesh& original, const Layout& layout, i
 
 }  // namespace
 
-std::vector<double> vertex_angle_deficits(const TriMesh& mesh) {
-  std::vector<double> out(mesh.n_vertices(), 0.0);
-  for (auto vh : mesh.vertices()) {
-    if (mesh.is_boundary(vh)) continue;
-    double sum = 0;
-    for (auto h : mesh.voh_range(vh)) {
-      const Vec3 a = mesh.point(mesh.to_vertex_handle(h)) - mesh.point(vh);
-      const Vec3 b =
-          mesh.point(mesh.to_vertex_handle(mesh.next_halfedge_handle(h))) - mesh.point(vh);
-      const double la = a.norm(), lb = b.norm();
-      if (la > 0 && lb > 0) sum += std::acos(std::clamp((a | b) / (la * lb), -1.0, 1.0));
-    }
-    out[vh.idx()] = 2 * M_PI - sum;
-  }
+std::vector<double> vertex_angle_deficits(const GeometryCache& geometry) {
+  std::vector<double> out = geometry.angle_defect;
+  for (int v = 0; v < geometry.n_vertices; ++v)
+    if (geometry.vertex_on_boundary[v]) out[v] = 0.0;
   return out;
 }
 
@@ -63,19 +53,9 @@ ConeCandidates cone_candidates(const TriMesh& original, const TriMesh& mesh, con
                                double tolerance, int rings, int max_targets) {
   ConeCandidates out;
   std::vector<int> valence(layout.nodes.size(), 0);
-  {
-    std::vector<int> index_of_id;
-    for (size_t n = 0; n < layout.nodes.size(); ++n) {
-      const int id = layout.nodes[n].id;
-      if (id >= static_cast<int>(index_of_id.size())) index_of_id.resize(id + 1, -1);
-      index_of_id[id] = static_cast<int>(n);
-    }
-    auto count = [&](int id) {
-      if (id >= 0 && id < static_cast<int>(index_of_id.size()) && index_of_id[id] >= 0)
-        ++valence[index_of_id[id]];
-    };
-    for (const auto& a : layout.arcs) count(a.from), count(a.to);
-  }
+  for (const auto& a : layout.arcs)
+    for (int id : {a.from, a.to})
+      if (const int n = layout.node_index(id); n >= 0) ++valence[n];
   const double tol = tolerance * M_PI / 2;
   std::vector<int> seen(original.n_vertices(), -1);
   for (int n : nodes) {

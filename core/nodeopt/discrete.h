@@ -9,6 +9,7 @@
 
 #include "core/base/progress.h"
 #include "core/layout/layout.h"
+#include "core/mesh/geometry.h"
 #include "core/mesh/mesh.h"
 #include "core/nodeopt/optimizer.h"
 #include "core/pipeline/pipeline.h"
@@ -66,8 +67,9 @@ struct HopSweepResult {
   int foldovers = 0;    //!< fold-overs of the final state
 };
 
-//! Angle deficit 2π − Σ angles at every vertex of \p mesh (radians; boundary vertices 0).
-std::vector<double> vertex_angle_deficits(const TriMesh& mesh);
+//! Angle deficit 2π − Σ angles at every vertex (GeometryCache::angle_defect; radians), 0 at
+//! boundary vertices.
+std::vector<double> vertex_angle_deficits(const GeometryCache& geometry);
 
 //! Hop candidates at sharp cone vertices, which the continuous descent cannot reach (it never
 //! places a node exactly on a vertex's original position, and a relocated cone vertex loses its

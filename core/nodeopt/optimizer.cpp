@@ -127,7 +127,8 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
   State state{mesh, layout, {}};
   for (const auto& n : layout.nodes) state.anchor.push_back(vertex_surface_point(mesh, n.vertex));
   const std::vector<int> movable = movable_nodes(mesh, layout);
-  const double mean_edge = build_geometry(mesh).mean_edge_length;
+  const GeometryCache original_geometry = build_geometry(mesh);
+  const double mean_edge = original_geometry.mean_edge_length;
 
   check_cancel(observer);
   Evaluation current;
@@ -255,7 +256,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     ConeCandidates cones;
     auto find_cones = [&]() {
       if (!no.hop_cones) return;
-      if (deficits.empty()) deficits = vertex_angle_deficits(original);
+      if (deficits.empty()) deficits = vertex_angle_deficits(original_geometry);
       cones = cone_candidates(original, hopped.mesh, hopped.layout, movable, deficits,
                               no.hop_cone_tolerance, no.hop_cone_rings, no.hop_cone_targets);
     };
