@@ -75,6 +75,39 @@ TEST(SolverThreads, OneThreadFactorizesWithoutHelperThreads) {
   set_solver_threads(0);
 }
 
+// The limited thread's parallel regions run inline (solver_threads.cpp defines GOMP_parallel,
+// and the executable must export it to CHOLMOD); with two solver threads the regions that ask
+// for more threads reach libgomp again. Both factorizations are right.
+TEST(SolverThreads, SerialRegionsRunInlineAndOthersReachLibgomp) {
+  if (dlsym(RTLD_DEFAULT, "omp_get_max_active_levels") == nullptr)
+    GTEST_SKIP() << "CHOLMOD is built without OpenMP here";
+  const Eigen::SparseMatrix<double> A = grid_matrix(160);
+  const Eigen::VectorXd x_true = Eigen::VectorXd::LinSpaced(A.rows(), -1.0, 2.0);
+  const Eigen::VectorXd b = A * x_true;
+  for (int threads : {1, 2}) {
+    set_solver_threads(threads);
+    std::uint64_t inline_regions = 0, forwarded = 0;
+    double error = 1.0;
+    std::thread worker([&] {
+      limit_solver_threads_here();
+      SpdSolver solver("threads test");
+      solver.factorize(A);
+      error = (solver.solve(b) - x_true).norm() / x_true.norm();
+      inline_regions = inline_parallel_regions_here();
+      forwarded = forwarded_parallel_regions_here();
+    });
+    worker.join();
+    EXPECT_LT(error, 1e-10) << threads << " threads";
+    EXPECT_GT(inline_regions, 0u) << threads << " threads: CHOLMOD's regions bypass the shim";
+    if (threads == 1) {
+      EXPECT_EQ(forwarded, 0u) << "a limited thread's region went to libgomp";
+    } else {
+      EXPECT_GT(forwarded, 0u) << "regions that may use 2 threads must reach libgomp";
+    }
+  }
+  set_solver_threads(0);
+}
+
 // --threads is checked and applied (it used to be accepted and ignored).
 TEST(SolverThreads, CommandLineChecksTheCount) {
   if (!std::filesystem::exists(test::cli_path())) GTEST_SKIP() << "quadsketch-cli not built";

@@ -3,6 +3,7 @@
 #include <dlfcn.h>
 
 #include <atomic>
+#include <cstdint>
 #include <cstdlib>
 
 namespace qs {
@@ -23,6 +24,9 @@ template <typename Fn>
 Fn lookup(const char* name) {
   return reinterpret_cast<Fn>(dlsym(RTLD_DEFAULT, name));
 }
+
+thread_local std::uint64_t t_inline_regions = 0;
+thread_local std::uint64_t t_forwarded_regions = 0;
 
 void set_openblas_threads(int n) {
   using SetThreads = void (*)(int);
@@ -67,4 +71,41 @@ void limit_solver_threads_here() {
     set_openblas_threads(threads);
 }
 
+std::uint64_t inline_parallel_regions_here() {
+  return t_inline_regions;
+}
+
+std::uint64_t forwarded_parallel_regions_here() {
+  return t_forwarded_regions;
+}
+
 }  // namespace qs
+
+// libgomp's entry point of every `#pragma omp parallel` compiled by GCC ≥ 4.9 (CHOLMOD's
+// included), defined here so that the dynamic linker binds CHOLMOD's calls to this definition
+// first (an executable's symbols precede the libraries'). See solver_threads.h: a region that
+// libgomp would run with a team of one thread runs inline, without the team's allocation and
+// barrier; every other region goes on to libgomp unchanged.
+extern "C" void GOMP_parallel(void (*fn)(void*), void* data, unsigned num_threads, unsigned flags) {
+  using Parallel = void (*)(void (*)(void*), void*, unsigned, unsigned);
+  using GetInt = int (*)();
+  static const Parallel next = reinterpret_cast<Parallel>(dlsym(RTLD_NEXT, "GOMP_parallel"));
+  static const GetInt max_active_levels =
+      reinterpret_cast<GetInt>(dlsym(RTLD_DEFAULT, "omp_get_max_active_levels"));
+  static const GetInt active_level =
+      reinterpret_cast<GetInt>(dlsym(RTLD_DEFAULT, "omp_get_active_level"));
+  // libgomp gives a region one thread when it asks for one (an `if` clause that is false
+  // passes 1) or when the active nesting level has reached max-active-levels (0 in a thread
+  // limited to one solver thread). Run inline, the region sees the same thread number (0)
+  // and team size (1); only omp_get_level() reads one less.
+  const bool one_thread = num_threads == 1 || next == nullptr ||
+                          (max_active_levels != nullptr && active_level != nullptr &&
+                           max_active_levels() <= active_level());
+  if (one_thread) {
+    ++qs::t_inline_regions;
+    fn(data);
+    return;
+  }
+  ++qs::t_forwarded_regions;
+  next(fn, data, num_threads, flags);
+}
