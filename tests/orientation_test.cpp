@@ -213,7 +213,9 @@ TEST(OrientationParam, DenseDualAndSparsePrimalSolversAgree) {
   const auto in = test::cube_sphere(6);
   const Layout layout = displaced(in, 3, 2);
   Pipeline dense(in.mesh, layout, with_orientation());
-  Pipeline sparse(in.mesh, layout, with_orientation(0));
+  PipelineOptions sparse_options = with_orientation(0);
+  sparse_options.param.orientation.all_faces_when_sparse = false;  // the same constraint set
+  Pipeline sparse(in.mesh, layout, sparse_options);
   const Parameterization& a = dense.compute_parameterization();
   const Parameterization& b = sparse.compute_parameterization();
   ASSERT_GT(a.orientation.foldovers_before, 0);
@@ -228,6 +230,47 @@ TEST(OrientationParam, DenseDualAndSparsePrimalSolversAgree) {
     for (int k = 0; k < 2; ++k)
       worst = std::max(worst, std::abs(a.corner_uv[c][k] - b.corner_uv[c][k]));
   EXPECT_LT(worst, 1e-4);
+}
+
+// When the folded faces and their rings need the sparse solver, every face is constrained in
+// one QP (all_faces_when_sparse). Its feasible set lies inside that of any smaller set, so its
+// optimum is not below the rounds' result; it must still remove every fold-over and keep the
+// equality constraints exact.
+TEST(OrientationParam, AllFacesAtOnceWhenTheSetNeedsTheSparseSolver) {
+  const auto in = test::cube_sphere(6);
+  const Layout layout = displaced(in, 4, 1);
+  Pipeline plain(in.mesh, layout, PipelineOptions{});
+  const Parameterization& before = plain.compute_parameterization();
+  ASSERT_GT(before.foldovers, 5) << "the test case must fold without the constraints";
+  PipelineOptions all_options = with_orientation(0);  // no dense solver: the sparse path
+  Pipeline all(in.mesh, layout, all_options);
+  const Parameterization& a = all.compute_parameterization();
+  PipelineOptions rounds_options = with_orientation(0);
+  rounds_options.param.orientation.all_faces_when_sparse = false;
+  Pipeline rounds(in.mesh, layout, rounds_options);
+  const Parameterization& r = rounds.compute_parameterization();
+  std::printf(
+      "[stat] displaced sphere, sparse solver: all faces %d fold-overs, E %.6g, %d iterations; "
+      "rounds %d fold-overs, E %.6g, %d rounds, %d iterations, %d faces\n",
+      a.foldovers, a.energy, a.orientation.iterations, r.foldovers, r.energy, r.orientation.rounds,
+      r.orientation.iterations, r.orientation.constrained_faces);
+  EXPECT_TRUE(a.orientation.all_faces);
+  EXPECT_FALSE(r.orientation.all_faces);
+  EXPECT_TRUE(a.orientation.success) << a.orientation.message;
+  EXPECT_EQ(a.orientation.rounds, 1);
+  EXPECT_EQ(a.orientation.constrained_faces + a.orientation.skipped_faces,
+            static_cast<int>(in.mesh.n_faces()));
+  EXPECT_LT(r.orientation.constrained_faces, a.orientation.constrained_faces);
+  EXPECT_EQ(a.foldovers, 0);
+  for (int f = 0; f < static_cast<int>(in.mesh.n_faces()); ++f)
+    ASSERT_GT(param_signed_area2(a.corner_uv, f), 0.0) << "face " << f;
+  EXPECT_GE(a.energy, before.energy * (1 - 1e-12));
+  if (r.foldovers == 0) EXPECT_GE(a.energy, r.energy * (1 - 1e-7));
+  EXPECT_LE(a.energy, before.energy * 1.15);
+  double fit = 0;
+  EXPECT_LT(constraint_violation(*all.param_solver(), a, &fit), 1e-9);
+  EXPECT_LT(fit, 1e-9);
+  EXPECT_TRUE(all.extract().structurally_equivalent);
 }
 
 TEST(OrientationParam, WithoutFoldsTheSolveIsUnchanged) {

@@ -191,6 +191,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
            {{"ran", node_result->orientation.ran},
             {"success", node_result->orientation.success},
             {"constrained_faces", node_result->orientation.constrained_faces},
+            {"all_faces", node_result->orientation.all_faces},
             {"rounds", node_result->orientation.rounds},
             {"iterations", node_result->orientation.iterations},
             {"time_s", node_result->orientation.time_s},
