@@ -397,6 +397,8 @@ void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const Geom
       gauge_angle_ = field_.theta[field_.gauge_face];
       matrix_.coeffRef(field_.gauge_face, field_.gauge_face) += lambda;
     }
+    // The trial's solve re-rounds the cluster offsets: kept to restore the field exactly.
+    const std::vector<int> offsets_before = cluster_offset_;
     factorize(spare_, matrix_);
     std::swap(solver_, spare_);
     solve(g);
@@ -420,6 +422,7 @@ void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const Geom
         gauge_angle_ = gauge_angle_before;
       }
       for (int cl : drop) in_drop[cl] = 0;
+      cluster_offset_ = offsets_before;  // the field before the trial, not a re-rounding of it
       solve(g);
       break;
     }
