@@ -214,7 +214,7 @@ TEST(OrientationParam, DenseDualAndSparsePrimalSolversAgree) {
   const Layout layout = displaced(in, 3, 2);
   Pipeline dense(in.mesh, layout, with_orientation());
   PipelineOptions sparse_options = with_orientation(0);
-  sparse_options.param.orientation.all_faces_when_sparse = false;  // the same constraint set
+  sparse_options.param.orientation.all_faces_after_rounds = 0;  // the same constraint set
   Pipeline sparse(in.mesh, layout, sparse_options);
   const Parameterization& a = dense.compute_parameterization();
   const Parameterization& b = sparse.compute_parameterization();
@@ -232,21 +232,22 @@ TEST(OrientationParam, DenseDualAndSparsePrimalSolversAgree) {
   EXPECT_LT(worst, 1e-4);
 }
 
-// When the folded faces and their rings need the sparse solver, every face is constrained in
-// one QP (all_faces_when_sparse). Its feasible set lies inside that of any smaller set, so its
-// optimum is not below the rounds' result; it must still remove every fold-over and keep the
-// equality constraints exact.
-TEST(OrientationParam, AllFacesAtOnceWhenTheSetNeedsTheSparseSolver) {
+// After a sparse round that left fold-overs outside its set (all_faces_after_rounds = 1 here),
+// every face is constrained in the next QP. Its feasible set lies inside that of any smaller
+// set, so its optimum is not below the growing rounds' result; it must still remove every
+// fold-over and keep the equality constraints exact.
+TEST(OrientationParam, AllFacesAfterAnUnfinishedSparseRound) {
   const auto in = test::cube_sphere(6);
   const Layout layout = displaced(in, 4, 1);
   Pipeline plain(in.mesh, layout, PipelineOptions{});
   const Parameterization& before = plain.compute_parameterization();
   ASSERT_GT(before.foldovers, 5) << "the test case must fold without the constraints";
   PipelineOptions all_options = with_orientation(0);  // no dense solver: the sparse path
+  all_options.param.orientation.all_faces_after_rounds = 1;
   Pipeline all(in.mesh, layout, all_options);
   const Parameterization& a = all.compute_parameterization();
   PipelineOptions rounds_options = with_orientation(0);
-  rounds_options.param.orientation.all_faces_when_sparse = false;
+  rounds_options.param.orientation.all_faces_after_rounds = 0;
   Pipeline rounds(in.mesh, layout, rounds_options);
   const Parameterization& r = rounds.compute_parameterization();
   std::printf(
@@ -257,7 +258,8 @@ TEST(OrientationParam, AllFacesAtOnceWhenTheSetNeedsTheSparseSolver) {
   EXPECT_TRUE(a.orientation.all_faces);
   EXPECT_FALSE(r.orientation.all_faces);
   EXPECT_TRUE(a.orientation.success) << a.orientation.message;
-  EXPECT_EQ(a.orientation.rounds, 1);
+  ASSERT_GE(r.orientation.rounds, 2) << "the case must need more than one growing round";
+  EXPECT_EQ(a.orientation.rounds, 2);
   EXPECT_EQ(a.orientation.constrained_faces + a.orientation.skipped_faces,
             static_cast<int>(in.mesh.n_faces()));
   EXPECT_LT(r.orientation.constrained_faces, a.orientation.constrained_faces);

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace qs {
 
@@ -33,13 +34,33 @@ class Tracer {
       : mesh_(mesh), g_(g), p_(p), uv_(uv), node_at_(node_at_vertex), opt_(opt) {}
 
   TracedArc trace(int start_vertex, int chart_face, int symbol, int end_node, int start_node) {
-    TracedArc out;
-    out.iso_u = symbol % 2 == 1;
-    V2 dir = rotate(symbol, V2{1.0, 0.0});
-    int face = chart_face;
-    if (!find_sector(start_vertex, face, dir))
+    const V2 dir = rotate(symbol, V2{1.0, 0.0});
+    const std::vector<Start> starts = start_sectors(start_vertex, chart_face, dir);
+    if (starts.empty()) {
+      TracedArc out;
+      out.iso_u = symbol % 2 == 1;
       return fail(out, "no start sector at vertex " + std::to_string(start_vertex) +
                            fold_note(start_vertex));
+    }
+    // The nearest occurrence first; the other one when only it reaches the end node.
+    TracedArc first = trace_from(start_vertex, starts[0], symbol, end_node, start_node);
+    if (first.ok || starts.size() < 2) return first;
+    TracedArc second = trace_from(start_vertex, starts[1], symbol, end_node, start_node);
+    return second.ok ? second : first;
+  }
+
+ private:
+  struct Start {
+    int face = -1;
+    V2 dir{0, 0};
+  };
+
+  TracedArc trace_from(int start_vertex, const Start& start, int symbol, int end_node,
+                       int start_node) {
+    TracedArc out;
+    out.iso_u = symbol % 2 == 1;
+    int face = start.face;
+    V2 dir = start.dir;
     add_vertex_sample(out, face, start_vertex);
     V2 point = at(face, start_vertex);
     int at_vertex = start_vertex;
@@ -143,7 +164,6 @@ class Tracer {
     return fail(out, "step limit reached");
   }
 
- private:
   V2 at(int f, int v) const { return uv_[3 * f + corner_of(g_, f, v)]; }
 
   bool folded(int f) const {
@@ -180,6 +200,100 @@ class Tracer {
     if (cross(a, b) <= 0) return false;  // folded corner
     const double tol = 1e-9;
     return cross(a, dir) >= -tol && cross(dir, b) >= -tol;
+  }
+
+  // Angle at w from the direction of w's edge `first` (w → next corner of f) to `d`, ccw, in
+  // f's chart, and the angle of the whole corner wedge (negative when folded).
+  double angle_from_first_edge(int f, int w, const V2& d) const {
+    const int k = corner_of(g_, f, w);
+    const V2 a = sub(uv_[3 * f + (k + 1) % 3], uv_[3 * f + k]);
+    return std::atan2(cross(a, d), dot(a, d));
+  }
+  double wedge_angle(int f, int w) const {
+    const int k = corner_of(g_, f, w);
+    const V2 a = sub(uv_[3 * f + (k + 1) % 3], uv_[3 * f + k]);
+    const V2 b = sub(uv_[3 * f + (k + 2) % 3], uv_[3 * f + k]);
+    return std::atan2(cross(a, b), dot(a, b));
+  }
+
+  // The start of an arc at its node vertex w: `face` is the chart face left of the arc's first
+  // edge (w → next corner), `dir` its direction there. Around a cone vertex the same direction
+  // occurs more than once (a valence-5 node's 450° hold it at two positions 90° apart): the
+  // first occurrence each way around w (ccw from the first edge, `face` included, and cw
+  // across it, through the transitions), the one nearer the first edge in parametric angle
+  // first. Only one of them is the iso-line that reaches the arc's end
+  // node; trace() tries the second when the first does not. (Alternating single steps both
+  // ways took the occurrence fewer wedges away: on the 70K bunny after node optimization
+  // three arcs of a valence-5 node started one sector off and ran into their neighbours'
+  // nodes, although the parameterization had no fold-over.)
+  std::vector<Start> start_sectors(int w, int face, const V2& dir) const {
+    const auto vw = mesh_.vertex_handle(w);
+    HH o0;
+    for (auto h : mesh_.fh_range(mesh_.face_handle(face)))
+      if (mesh_.from_vertex_handle(h) == vw) o0 = h;
+    int degree = 0;
+    for (auto h : mesh_.voh_range(vw)) (void)h, ++degree;
+    const double inf = std::numeric_limits<double>::infinity();
+    // ccw: across the edge of prev(halfedge) (towards the wedge's second side).
+    double ccw_angle = inf, swept = wedge_angle(face, w);
+    int ccw_face = -1;
+    V2 ccw_dir = dir;
+    if (in_wedge(face, w, dir)) {
+      ccw_angle = angle_from_first_edge(face, w, dir);
+      ccw_face = face;
+    } else {
+      HH cur = o0;
+      V2 d = dir;
+      for (int s = 0; s < degree; ++s) {
+        const HH in = mesh_.prev_halfedge_handle(cur);
+        const HH out = mesh_.opposite_halfedge_handle(in);
+        if (mesh_.is_boundary(out)) break;
+        d = rotate(
+            step_rotation(p_[mesh_.edge_handle(in).idx()], mesh_.from_vertex_handle(in).idx(), w),
+            d);
+        cur = out;
+        const int f = mesh_.face_handle(cur).idx();
+        if (in_wedge(f, w, d)) {
+          ccw_angle = swept + angle_from_first_edge(f, w, d);
+          ccw_face = f;
+          ccw_dir = d;
+          break;
+        }
+        swept += wedge_angle(f, w);
+      }
+    }
+    // cw: across the first edge itself.
+    double cw_angle = inf;
+    int cw_face = -1;
+    V2 cw_dir = dir;
+    {
+      HH cur = o0;
+      V2 d = dir;
+      swept = 0;
+      for (int s = 0; s < degree; ++s) {
+        const HH opp = mesh_.opposite_halfedge_handle(cur);
+        if (mesh_.is_boundary(opp)) break;
+        d = rotate(
+            step_rotation(p_[mesh_.edge_handle(cur).idx()], w, mesh_.to_vertex_handle(cur).idx()),
+            d);
+        cur = mesh_.next_halfedge_handle(opp);
+        const int f = mesh_.face_handle(cur).idx();
+        if (in_wedge(f, w, d)) {
+          cw_angle = swept + (wedge_angle(f, w) - angle_from_first_edge(f, w, d));
+          cw_face = f;
+          cw_dir = d;
+          break;
+        }
+        swept += wedge_angle(f, w);
+      }
+    }
+    std::vector<Start> out;
+    if (ccw_face >= 0) out.push_back({ccw_face, ccw_dir});
+    // (Both ways can end in one face with two different directions: keep both.)
+    if (cw_face >= 0 && (cw_face != ccw_face || norm(sub(cw_dir, ccw_dir)) > 1e-9))
+      out.push_back({cw_face, cw_dir});
+    if (out.size() == 2 && cw_angle < ccw_angle) std::swap(out[0], out[1]);
+    return out;
   }
 
   // Finds the face around w (starting at `face`, sweeping both ways with transitions) whose

@@ -73,14 +73,18 @@ struct OrientationOptions {
   //! … and while m³ ≤ dense_cost_ratio · #y^1.5: a dense m×m Cholesky per iteration must stay
   //! cheaper than a sparse factorization (≈ #y^1.5 for surface meshes). Deterministic choice.
   double dense_cost_ratio = 100.0;
-  //! When the first round's set (folded faces and their rings) is too large for the dense
-  //! solver, every face is constrained at once instead: the primal solver factorizes a matrix
-  //! of A's size in each iteration however many rows there are, and rounds that grow the set
-  //! mostly find new fold-overs just outside it. On the 70K bunny after 25 descent steps (897
-  //! fold-overs): 0 fold-overs after one QP of 22 iterations, 4 s, E 0.0506, where the rounds
-  //! (rings 2) left 21 after 5 rounds and 89 iterations, 11 s, E 0.0505. If that QP is
-  //! infeasible (the constraints are only sufficient for orientation), the rounds follow.
-  bool all_faces_when_sparse = true;
+  //! After this many rounds solved by the sparse (primal) solver that left fold-overs outside
+  //! their set, the next round constrains every face instead of growing the set (0: never).
+  //! The primal solver factorizes a matrix of A's size in each iteration however many rows
+  //! there are, and on large models growing rounds keep finding new fold-overs just outside
+  //! the set: on the 70K bunny after 25 descent steps (897 fold-overs) rings-2 rounds left 21
+  //! fold-overs after 5 rounds and 89 iterations (11 s); every face constrained at once, 0 in
+  //! 24 iterations (4 s), E 0.0506 either way. But the constraints also bind faces that would
+  //! not fold: on spot (18 fold-overs after the descent, E 1.453) every face gives E 1.520
+  //! where two growing rounds (334 faces) give 1.496, hence not after the first round. If the
+  //! all-faces round is infeasible (the constraints are only sufficient for orientation), the
+  //! growing rounds go on.
+  int all_faces_after_rounds = 2;
 };
 
 struct OrientationReport {
