@@ -212,7 +212,6 @@ class NormalMatrix {
 struct IpmOutcome {
   bool converged = false;
   bool infeasible = false;
-  bool stalled = false;  // stopped near the optimum without reaching the tolerance
   int iterations = 0;
   double primal_residual = 0;
 };
@@ -299,8 +298,7 @@ IpmOutcome interior_point(const Eigen::SparseMatrix<double>& A, const Eigen::Vec
       y_best = y;
       since_best = 0;
     } else if (best_merit <= kNear && ++since_best >= kStall) {
-      out.stalled = true;
-      return finish();
+      return finish();  // stalled near the optimum
     }
     if (!std::isfinite(mu) || lambda.lpNorm<Eigen::Infinity>() > 1e14) {
       return finish();  // the multipliers diverge: no point satisfies C y ≥ d
