@@ -20,6 +20,7 @@
 #include "core/mesh/mesh_checks.h"
 #include "core/mesh/mesh_io.h"
 #include "core/nodeopt/gradient.h"
+#include "core/nodeopt/relocation.h"
 
 namespace qs::test {
 
@@ -599,6 +600,20 @@ EmbeddingCheck check_embedding(const TriMesh& mesh, const GeometryCache& geometr
     }
   }
   return check;
+}
+
+Layout displace_nodes(const TriMesh& mesh, Layout layout, int rings, int seed) {
+  for (int n = 0; n < static_cast<int>(layout.nodes.size()); ++n) {
+    if (layout.nodes[n].pinned) continue;
+    const auto cand = ring_vertices(mesh, layout.nodes[n].vertex, rings);
+    for (size_t k = 0; k < cand.size(); ++k) {
+      const int w = cand[(k + static_cast<size_t>(seed) * 7 + n * 3) % cand.size()];
+      const auto forbidden = forbidden_relocation_vertices(mesh, layout, n);
+      if (forbidden[w]) continue;
+      if (move_node_and_reroute(mesh, layout, n, w)) break;
+    }
+  }
+  return layout;
 }
 
 std::vector<int> ring_vertices(const TriMesh& mesh, int v, int rings) {

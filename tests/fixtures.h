@@ -147,6 +147,11 @@ EmbeddingCheck check_embedding(const TriMesh& mesh, const GeometryCache& geometr
 //! The vertices at exactly \p rings edge hops from vertex \p v (breadth-first search).
 std::vector<int> ring_vertices(const TriMesh& mesh, int v, int rings);
 
+//! \p layout with every unpinned node moved to a vertex \p rings edge rings away (the choice
+//! rotates with \p seed; vertices other nodes or arcs forbid are skipped), its arcs re-routed:
+//! a valid layout with the same structure.
+Layout displace_nodes(const TriMesh& mesh, Layout layout, int rings, int seed);
+
 //! Energy of a moved mesh: (mesh, its geometry, the frozen field θ per face).
 using MovedEnergy =
     std::function<double(const TriMesh&, const GeometryCache&, const std::vector<double>&)>;

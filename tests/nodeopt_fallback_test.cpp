@@ -23,22 +23,6 @@
 namespace qs {
 namespace {
 
-// Moves every unpinned node `rings` edge rings away (the choice rotates with `seed`), re-routing
-// its arcs (as tests/nodeopt_test.cpp).
-Layout perturb_layout(const TriMesh& mesh, Layout layout, int rings, int seed) {
-  for (int n = 0; n < static_cast<int>(layout.nodes.size()); ++n) {
-    if (layout.nodes[n].pinned) continue;
-    const auto cand = test::ring_vertices(mesh, layout.nodes[n].vertex, rings);
-    for (size_t k = 0; k < cand.size(); ++k) {
-      const int w = cand[(k + static_cast<size_t>(seed) * 7 + n * 3) % cand.size()];
-      const auto forbidden = forbidden_relocation_vertices(mesh, layout, n);
-      if (forbidden[w]) continue;
-      if (move_node_and_reroute(mesh, layout, n, w)) break;
-    }
-  }
-  return layout;
-}
-
 // Faces whose parametric triangle has non-positive signed area (counted here from the corner
 // values, independently of Parameterization::foldovers).
 int count_folds(const std::vector<std::array<double, 2>>& uv) {
@@ -75,7 +59,7 @@ struct OptimizedCase {
 
 OptimizedCase optimize_case(int stiffening_iterations) {
   const auto cs = test::cube_sphere(8, Vec3(1.3, 1, 0.75));
-  const Layout start = perturb_layout(cs.mesh, cs.layout, 4, 7);
+  const Layout start = test::displace_nodes(cs.mesh, cs.layout, 4, 7);
   NodeOptOptions no;
   no.max_steps = 4;
   no.hop_polish = false;  // no pre-polish state: only the fewest-fold-over fallback

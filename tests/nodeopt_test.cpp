@@ -28,22 +28,6 @@
 namespace qs {
 namespace {
 
-// Moves every (unpinned) node `rings` edge rings away (the choice rotates with `seed`),
-// re-routing its arcs; keeps the layout valid with the same structure.
-Layout perturb_layout(const TriMesh& mesh, Layout layout, int rings, int seed) {
-  for (int n = 0; n < static_cast<int>(layout.nodes.size()); ++n) {
-    if (layout.nodes[n].pinned) continue;
-    const auto cand = test::ring_vertices(mesh, layout.nodes[n].vertex, rings);
-    for (size_t k = 0; k < cand.size(); ++k) {
-      const int w = cand[(k + static_cast<size_t>(seed) * 7 + n * 3) % cand.size()];
-      const auto forbidden = forbidden_relocation_vertices(mesh, layout, n);
-      if (forbidden[w]) continue;
-      if (move_node_and_reroute(mesh, layout, n, w)) break;
-    }
-  }
-  return layout;
-}
-
 std::vector<int> node_vertices(const Layout& layout) {
   std::vector<int> out;
   for (const auto& n : layout.nodes) out.push_back(n.vertex);
@@ -122,7 +106,7 @@ TEST(NodeGradient, EstimatorMatchesFrozenFieldDifferencesOnEllipsoid) {
 
 TEST(NodeGradient, EstimatorMatchesFrozenFieldDifferencesOnDisplacedNodes) {
   const auto in = test::cube_sphere(8);
-  const Layout moved = perturb_layout(in.mesh, in.layout, 2, 1);
+  const Layout moved = test::displace_nodes(in.mesh, in.layout, 2, 1);
   int checked = 0;
   const double worst = frozen_gradient_check({in.mesh, moved}, &checked);
   std::printf("[stat] sphere, nodes displaced 2 rings: %d nodes, worst relative error %.3g\n",
@@ -135,7 +119,7 @@ TEST(NodeGradient, EstimatorMatchesFrozenFieldDifferencesOnDisplacedNodes) {
 TEST(NodeGradient, EstimatorVersusExactWithFieldResolved) {
   const auto sphere = test::cube_sphere(8);
   const test::MeshAndLayout cases[] = {
-      {sphere.mesh, perturb_layout(sphere.mesh, sphere.layout, 2, 1)},
+      {sphere.mesh, test::displace_nodes(sphere.mesh, sphere.layout, 2, 1)},
       test::cube_sphere(8, Vec3(1.3, 1, 0.75))};
   const char* names[] = {"sphere displaced", "ellipsoid"};
   for (int c = 0; c < 2; ++c) {
@@ -217,7 +201,7 @@ TEST(Geodesic, UnfoldsAcrossCubeEdge) {
 
 TEST(Relocation, ReroutingKeepsStructureAndValidity) {
   const auto in = test::cube_sphere(8);
-  const Layout moved = perturb_layout(in.mesh, in.layout, 3, 2);
+  const Layout moved = test::displace_nodes(in.mesh, in.layout, 3, 2);
   EXPECT_TRUE(validate_layout(in.mesh, moved).valid());
   EXPECT_TRUE(
       same_layout_structure(build_topology(in.mesh, in.layout), build_topology(in.mesh, moved)));
@@ -277,7 +261,7 @@ void expect_valid_mesh(const TriMesh& original, const TriMesh& mesh) {
 
 TEST(NodeOptimizer, DescendsOnPerturbedSphere) {
   const auto in = test::cube_sphere(8);
-  const Layout start = perturb_layout(in.mesh, in.layout, 2, 3);
+  const Layout start = test::displace_nodes(in.mesh, in.layout, 2, 3);
   Recorder rec;
   const NodeOptResult r = optimize_nodes(in.mesh, start, PipelineOptions{}, {}, &rec);
   std::printf(
@@ -293,7 +277,7 @@ TEST(NodeOptimizer, DescendsOnPerturbedSphere) {
 
 TEST(NodeOptimizer, DescendsOnPerturbedEllipsoid) {
   const auto in = test::cube_sphere(8, Vec3(1.3, 1, 0.75));
-  const Layout start = perturb_layout(in.mesh, in.layout, 2, 5);
+  const Layout start = test::displace_nodes(in.mesh, in.layout, 2, 5);
   Recorder rec;
   const NodeOptResult r = optimize_nodes(in.mesh, start, PipelineOptions{}, {}, &rec);
   std::printf(
@@ -493,7 +477,7 @@ TEST(NodeOptimizer, HopPolishReturnsConsistentState) {
   no.stiffen_at_end = false;
   int polished = 0;
   for (int seed : {6, 7, 8}) {
-    const Layout start = perturb_layout(in.mesh, in.layout, 4, seed);
+    const Layout start = test::displace_nodes(in.mesh, in.layout, 4, seed);
     Recorder rec;
     const NodeOptResult r = optimize_nodes(in.mesh, start, PipelineOptions{}, no, &rec);
     int last_folds = -1;
@@ -582,7 +566,7 @@ TEST(DiscreteRelocation, HopSweepReturnsDisplacedNode) {
 
 TEST(NodeOptimizer, PinnedNodesKeepTheirPosition) {
   const auto in = test::cube_sphere(8);
-  Layout start = perturb_layout(in.mesh, in.layout, 2, 3);
+  Layout start = test::displace_nodes(in.mesh, in.layout, 2, 3);
   start.nodes[0].pinned = true;
   start.nodes[5].pinned = true;
   const NodeOptResult r = optimize_nodes(in.mesh, start, PipelineOptions{});
@@ -601,7 +585,7 @@ TEST(NodeOptimizer, PinnedNodesKeepTheirPosition) {
 
 TEST(NodeOptimizer, ExactGradientDescends) {
   const auto in = test::cube_sphere(6);
-  const Layout start = perturb_layout(in.mesh, in.layout, 1, 3);
+  const Layout start = test::displace_nodes(in.mesh, in.layout, 1, 3);
   NodeOptOptions no;
   no.gradient = GradientMethod::Exact;
   no.max_steps = 4;
@@ -623,8 +607,8 @@ struct CancelAfter : Observer {
 TEST(NodeOptimizer, CancelsBetweenSolves) {
   const auto in = test::cube_sphere(6);
   CancelAfter obs(2);
-  EXPECT_THROW(optimize_nodes(in.mesh, perturb_layout(in.mesh, in.layout, 1, 0), PipelineOptions{},
-                              {}, &obs),
+  EXPECT_THROW(optimize_nodes(in.mesh, test::displace_nodes(in.mesh, in.layout, 1, 0),
+                              PipelineOptions{}, {}, &obs),
                Cancelled);
 }
 
@@ -634,7 +618,7 @@ TEST(NodeOptimizer, CancelsBetweenSolves) {
 TEST(Stiffening, WeightsChangeTheSolveAndReduceFoldovers) {
   const auto in = test::cube_sphere(8);
   // A badly displaced layout (4 rings) tends to fold.
-  const Layout start = perturb_layout(in.mesh, in.layout, 4, 6);
+  const Layout start = test::displace_nodes(in.mesh, in.layout, 4, 6);
   const StiffeningResult st = stiffen(in.mesh, start, PipelineOptions{});
   std::printf("[stat] stiffening: fold-overs %d -> %d in %d iterations, E %.6g -> %.6g\n",
               st.foldovers_before, st.foldovers_after, st.iterations, st.E_before, st.E_after);
@@ -657,7 +641,7 @@ TEST(Stiffening, WeightsChangeTheSolveAndReduceFoldovers) {
 
 TEST(DiscreteRelocation, LowersEnergy) {
   const auto in = test::cube_sphere(6);
-  const Layout start = perturb_layout(in.mesh, in.layout, 1, 3);
+  const Layout start = test::displace_nodes(in.mesh, in.layout, 1, 3);
   DiscreteOptions d;
   d.max_steps = 2;
   Recorder rec;
@@ -716,7 +700,7 @@ TEST(Relocation, LocalCheckAgreesWithFullValidation) {
 // κ continued, solver setup kept) gives the energy of a Pipeline built from scratch.
 TEST(Pipeline, UpdatePositionsMatchesFreshPipeline) {
   const auto in = test::cube_sphere(8, Vec3(1.3, 1, 0.75));
-  const Layout start = perturb_layout(in.mesh, in.layout, 2, 5);
+  const Layout start = test::displace_nodes(in.mesh, in.layout, 2, 5);
   PipelineOptions options;
   Pipeline reused(in.mesh, start, options);
   reused.compute_field();
@@ -760,7 +744,7 @@ TEST(Pipeline, UpdatePositionsMatchesFreshPipeline) {
 // start) reproduces fresh Pipelines on the same states.
 TEST(NodeOptimizer, ReuseMatchesFreshPipelines) {
   const auto in = test::cube_sphere(8, Vec3(1.3, 1, 0.75));
-  const Layout start = perturb_layout(in.mesh, in.layout, 2, 5);
+  const Layout start = test::displace_nodes(in.mesh, in.layout, 2, 5);
   PipelineOptions options;
   NodeOptOptions no;
   no.reuse_field = true;  // off by default (optimizer.h)

@@ -227,72 +227,82 @@ class Tracer {
   // three arcs of a valence-5 node started one sector off and ran into their neighbours'
   // nodes, although the parameterization had no fold-over.)
   std::vector<Start> start_sectors(int w, int face, const V2& dir) const {
-    const auto vw = mesh_.vertex_handle(w);
-    HH o0;
-    for (auto h : mesh_.fh_range(mesh_.face_handle(face)))
-      if (mesh_.from_vertex_handle(h) == vw) o0 = h;
-    int degree = 0;
-    for (auto h : mesh_.voh_range(vw)) (void)h, ++degree;
+    const HH o0 = outgoing_in_face(w, face);
+    const int degree = vertex_degree(w);
     const double inf = std::numeric_limits<double>::infinity();
-    // ccw: across the edge of prev(halfedge) (towards the wedge's second side).
+    // ccw from the first edge, `face` included.
     double ccw_angle = inf, swept = wedge_angle(face, w);
-    int ccw_face = -1;
-    V2 ccw_dir = dir;
+    Start ccw{-1, dir};
     if (in_wedge(face, w, dir)) {
       ccw_angle = angle_from_first_edge(face, w, dir);
-      ccw_face = face;
+      ccw.face = face;
     } else {
       HH cur = o0;
       V2 d = dir;
-      for (int s = 0; s < degree; ++s) {
-        const HH in = mesh_.prev_halfedge_handle(cur);
-        const HH out = mesh_.opposite_halfedge_handle(in);
-        if (mesh_.is_boundary(out)) break;
-        d = rotate(
-            step_rotation(p_[mesh_.edge_handle(in).idx()], mesh_.from_vertex_handle(in).idx(), w),
-            d);
-        cur = out;
+      for (int s = 0; s < degree && (cur = step_ccw(cur, w, d)).is_valid(); ++s) {
         const int f = mesh_.face_handle(cur).idx();
         if (in_wedge(f, w, d)) {
           ccw_angle = swept + angle_from_first_edge(f, w, d);
-          ccw_face = f;
-          ccw_dir = d;
+          ccw = {f, d};
           break;
         }
         swept += wedge_angle(f, w);
       }
     }
-    // cw: across the first edge itself.
+    // cw across the first edge.
     double cw_angle = inf;
-    int cw_face = -1;
-    V2 cw_dir = dir;
+    Start cw{-1, dir};
     {
       HH cur = o0;
       V2 d = dir;
       swept = 0;
-      for (int s = 0; s < degree; ++s) {
-        const HH opp = mesh_.opposite_halfedge_handle(cur);
-        if (mesh_.is_boundary(opp)) break;
-        d = rotate(
-            step_rotation(p_[mesh_.edge_handle(cur).idx()], w, mesh_.to_vertex_handle(cur).idx()),
-            d);
-        cur = mesh_.next_halfedge_handle(opp);
+      for (int s = 0; s < degree && (cur = step_cw(cur, w, d)).is_valid(); ++s) {
         const int f = mesh_.face_handle(cur).idx();
         if (in_wedge(f, w, d)) {
           cw_angle = swept + (wedge_angle(f, w) - angle_from_first_edge(f, w, d));
-          cw_face = f;
-          cw_dir = d;
+          cw = {f, d};
           break;
         }
         swept += wedge_angle(f, w);
       }
     }
     std::vector<Start> out;
-    if (ccw_face >= 0) out.push_back({ccw_face, ccw_dir});
+    if (ccw.face >= 0) out.push_back(ccw);
     // (Both ways can end in one face with two different directions: keep both.)
-    if (cw_face >= 0 && (cw_face != ccw_face || norm(sub(cw_dir, ccw_dir)) > 1e-9))
-      out.push_back({cw_face, cw_dir});
+    if (cw.face >= 0 && (cw.face != ccw.face || norm(sub(cw.dir, ccw.dir)) > 1e-9))
+      out.push_back(cw);
     if (out.size() == 2 && cw_angle < ccw_angle) std::swap(out[0], out[1]);
+    return out;
+  }
+
+  // The outgoing halfedge of vertex w in face f, and w's number of outgoing halfedges.
+  HH outgoing_in_face(int w, int f) const {
+    const auto vw = mesh_.vertex_handle(w);
+    for (auto h : mesh_.fh_range(mesh_.face_handle(f)))
+      if (mesh_.from_vertex_handle(h) == vw) return h;
+    return HH();
+  }
+  int vertex_degree(int w) const {
+    int degree = 0;
+    for (auto h : mesh_.voh_range(mesh_.vertex_handle(w))) (void)h, ++degree;
+    return degree;
+  }
+  // One face around w from the face of w's outgoing halfedge `cur`: cw crosses cur's edge,
+  // ccw crosses the edge of prev(cur) (the wedge's second side). Returns the next face's
+  // outgoing halfedge of w (invalid at the boundary) and carries `d` into its chart.
+  HH step_cw(HH cur, int w, V2& d) const {
+    const HH opp = mesh_.opposite_halfedge_handle(cur);
+    if (mesh_.is_boundary(opp)) return HH();
+    d = rotate(
+        step_rotation(p_[mesh_.edge_handle(cur).idx()], w, mesh_.to_vertex_handle(cur).idx()), d);
+    return mesh_.next_halfedge_handle(opp);
+  }
+  HH step_ccw(HH cur, int w, V2& d) const {
+    const HH in = mesh_.prev_halfedge_handle(cur);
+    const HH out = mesh_.opposite_halfedge_handle(in);
+    if (mesh_.is_boundary(out)) return HH();
+    d = rotate(
+        step_rotation(p_[mesh_.edge_handle(in).idx()], mesh_.from_vertex_handle(in).idx(), w), d);
     return out;
   }
 
@@ -300,48 +310,23 @@ class Tracer {
   // corner wedge contains dir; updates face and dir to that face's chart.
   bool find_sector(int w, int& face, V2& dir) const {
     if (in_wedge(face, w, dir)) return true;
-    const auto vw = mesh_.vertex_handle(w);
-    // Outgoing halfedge of w in `face`.
-    HH o0;
-    for (auto h : mesh_.fh_range(mesh_.face_handle(face)))
-      if (mesh_.from_vertex_handle(h) == vw) o0 = h;
-    int degree = 0;
-    for (auto h : mesh_.voh_range(vw)) (void)h, ++degree;
+    const HH o0 = outgoing_in_face(w, face);
+    const int degree = vertex_degree(w);
     HH cw = o0, ccw = o0;
     V2 dcw = dir, dccw = dir;
-    bool cw_open = true, ccw_open = true;
-    for (int s = 0; s < degree && (cw_open || ccw_open); ++s) {
-      if (cw_open) {  // cross edge of cw from face(cw) to face(opp(cw))
-        const HH opp = mesh_.opposite_halfedge_handle(cw);
-        if (mesh_.is_boundary(opp)) {
-          cw_open = false;
-        } else {
-          dcw = rotate(
-              step_rotation(p_[mesh_.edge_handle(cw).idx()], w, mesh_.to_vertex_handle(cw).idx()),
-              dcw);
-          cw = mesh_.next_halfedge_handle(opp);
-          const int f = mesh_.face_handle(cw).idx();
-          if (in_wedge(f, w, dcw)) {
-            face = f, dir = dcw;
-            return true;
-          }
+    for (int s = 0; s < degree && (cw.is_valid() || ccw.is_valid()); ++s) {
+      if (cw.is_valid() && (cw = step_cw(cw, w, dcw)).is_valid()) {
+        const int f = mesh_.face_handle(cw).idx();
+        if (in_wedge(f, w, dcw)) {
+          face = f, dir = dcw;
+          return true;
         }
       }
-      if (ccw_open) {  // cross the edge of prev(ccw) (b→w) from face(ccw) to face(w→b)
-        const HH in = mesh_.prev_halfedge_handle(ccw);
-        const HH out = mesh_.opposite_halfedge_handle(in);
-        if (mesh_.is_boundary(out)) {
-          ccw_open = false;
-        } else {
-          dccw = rotate(
-              step_rotation(p_[mesh_.edge_handle(in).idx()], mesh_.from_vertex_handle(in).idx(), w),
-              dccw);
-          ccw = out;
-          const int f = mesh_.face_handle(ccw).idx();
-          if (in_wedge(f, w, dccw)) {
-            face = f, dir = dccw;
-            return true;
-          }
+      if (ccw.is_valid() && (ccw = step_ccw(ccw, w, dccw)).is_valid()) {
+        const int f = mesh_.face_handle(ccw).idx();
+        if (in_wedge(f, w, dccw)) {
+          face = f, dir = dccw;
+          return true;
         }
       }
     }
