@@ -90,8 +90,9 @@ TEST_P(IntegerSizesOnLayouts, PatchSizesAreMultiplesOfQAndEnergyStaysClose) {
   // The energy stays within 10% of the relaxed one (issue #8) and nothing folds. (The flat
   // disk is isometric, E_relaxed = 0: any rounding costs energy, so only the curved cases are
   // measured relative to it.)
-  if (E_relaxed > 1e-6)
+  if (E_relaxed > 1e-6) {
     EXPECT_LE(p.energy, 1.10 * E_relaxed) << "relaxed " << E_relaxed << ", integer " << p.energy;
+  }
   EXPECT_EQ(p.foldovers, 0);
   // The traced patches have the rounded sizes.
   const Extraction& ex = fixed.extract();

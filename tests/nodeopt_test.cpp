@@ -979,7 +979,9 @@ TEST(NodeOptimizer, ParallelRetryGivesTheSequentialTrajectory) {
   const NodeOptResult a = optimize_example(NodeOptOptions{}, &s_seq);
   const NodeOptResult b = optimize_example(parallel, &s_par);
   EXPECT_EQ(s_seq.parallel_retries, 0);
-  if (std::thread::hardware_concurrency() >= 2) EXPECT_GT(s_par.parallel_retries, 0);
+  if (std::thread::hardware_concurrency() >= 2) {
+    EXPECT_GT(s_par.parallel_retries, 0);
+  }
   ASSERT_EQ(a.reports.size(), b.reports.size());
   for (size_t k = 0; k < a.reports.size(); ++k) {
     EXPECT_EQ(a.reports[k].accepted, b.reports[k].accepted) << "step " << k;

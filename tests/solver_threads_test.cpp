@@ -71,7 +71,9 @@ TEST(SolverThreads, OneThreadFactorizesWithoutHelperThreads) {
   worker.join();
   EXPECT_LT(error, 1e-10);
   EXPECT_EQ(after, before) << "the factorization started threads";
-  if (levels >= 0) EXPECT_EQ(levels, 0);
+  if (levels >= 0) {
+    EXPECT_EQ(levels, 0);
+  }
   set_solver_threads(0);
 }
 
