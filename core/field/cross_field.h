@@ -159,6 +159,10 @@ class CrossFieldSolver {
                                  int tolerated = 0);
   //! Interior edges whose principal matching differs from the period jump.
   int count_mismatches(const GeometryCache& geometry) const;
+  //! The energy the solve minimizes, at field_.theta: Σ over interior edges of the squared
+  //! step against transport and period jump, plus λ·(θ_f − target)² on the constraints in force
+  //! (current cluster offsets) and on the gauge face.
+  double energy(const GeometryCache& geometry) const;
 
   CrossFieldOptions options_;
   //! The curvature of the last constraint collection (update_layout recomputes only around
