@@ -397,7 +397,7 @@ void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const Geom
       gauge_angle_ = field_.theta[field_.gauge_face];
       matrix_.coeffRef(field_.gauge_face, field_.gauge_face) += lambda;
     }
-    // The trial's solve re-rounds the cluster offsets: kept to restore the field exactly.
+    // The trial's solve re-rounds the cluster offsets: kept for the restore below.
     const std::vector<int> offsets_before = cluster_offset_;
     factorize(spare_, matrix_);
     std::swap(solver_, spare_);
@@ -463,10 +463,10 @@ void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const Geom
 
 double CrossFieldSolver::energy(const GeometryCache& g) const {
   double e = 0;
-  for (int e_ = 0; e_ < g.n_edges; ++e_) {
-    if (!interior(g, e_)) continue;
-    const double d = field_.theta[g.edge_face_j[e_]] - field_.theta[g.edge_face_i[e_]] -
-                     g.kappa[e_] - kQuarter * field_.period_jump[e_];
+  for (int edge = 0; edge < g.n_edges; ++edge) {
+    if (!interior(g, edge)) continue;
+    const double d = field_.theta[g.edge_face_j[edge]] - field_.theta[g.edge_face_i[edge]] -
+                     g.kappa[edge] - kQuarter * field_.period_jump[edge];
     e += d * d;
   }
   const double lambda = options_.constraint_weight;
