@@ -892,7 +892,7 @@ TEST(DiscreteRelocation, ConeCandidatesFindPolycubeCorners) {
     EXPECT_NEAR(deficit[poly.layout.nodes[n].vertex], 2 * M_PI * (4 - valence[n]) / 4.0, 1e-9);
   }
   const ConeCandidates exact =
-      cone_candidates(poly.mesh, poly.mesh, poly.layout, all, deficit, 0.25, 2, 2);
+      cone_candidates(poly.mesh, poly.mesh, poly.layout, all, valence, deficit, 0.25, 2, 2);
   EXPECT_TRUE(exact.hop_nodes.empty());
   EXPECT_TRUE(exact.snap_nodes.empty());
 
@@ -901,7 +901,7 @@ TEST(DiscreteRelocation, ConeCandidatesFindPolycubeCorners) {
   po.seed = 2;
   const Layout displaced = qs::perturb_layout(poly.mesh, poly.layout, po).layout;
   const ConeCandidates c =
-      cone_candidates(poly.mesh, poly.mesh, displaced, all, deficit, 0.25, 2, 2);
+      cone_candidates(poly.mesh, poly.mesh, displaced, all, valence, deficit, 0.25, 2, 2);
   int checked = 0;
   for (size_t n = 0; n < all.size(); ++n) {
     if (valence[n] == 4 || displaced.nodes[n].vertex == poly.layout.nodes[n].vertex) continue;
@@ -921,7 +921,7 @@ TEST(DiscreteRelocation, ConeCandidatesFindPolycubeCorners) {
   const auto wh = *relocated.vv_iter(vh);
   relocated.set_point(vh, 0.8 * relocated.point(vh) + 0.2 * relocated.point(wh));
   const ConeCandidates snap =
-      cone_candidates(poly.mesh, relocated, poly.layout, all, deficit, 0.25, 2, 2);
+      cone_candidates(poly.mesh, relocated, poly.layout, all, valence, deficit, 0.25, 2, 2);
   EXPECT_EQ(snap.snap_nodes, std::vector<int>{0});
   EXPECT_TRUE(snap.hop_nodes.empty());
 
@@ -930,8 +930,9 @@ TEST(DiscreteRelocation, ConeCandidatesFindPolycubeCorners) {
   const Layout smooth_displaced = qs::perturb_layout(smooth.mesh, smooth.layout, po).layout;
   std::vector<int> smooth_all(smooth.layout.nodes.size());
   for (size_t n = 0; n < smooth_all.size(); ++n) smooth_all[n] = static_cast<int>(n);
-  const ConeCandidates none = cone_candidates(smooth.mesh, smooth.mesh, smooth_displaced,
-                                              smooth_all, smooth_deficit, 0.25, 2, 2);
+  const ConeCandidates none =
+      cone_candidates(smooth.mesh, smooth.mesh, smooth_displaced, smooth_all,
+                      node_valences(smooth.layout), smooth_deficit, 0.25, 2, 2);
   EXPECT_TRUE(none.hop_nodes.empty());
   EXPECT_TRUE(none.snap_nodes.empty());
 }

@@ -49,13 +49,10 @@ std::vector<double> vertex_angle_deficits(const GeometryCache& geometry) {
 }
 
 ConeCandidates cone_candidates(const TriMesh& original, const TriMesh& mesh, const Layout& layout,
-                               const std::vector<int>& nodes, const std::vector<double>& deficits,
-                               double tolerance, int rings, int max_targets) {
+                               const std::vector<int>& nodes, const std::vector<int>& valence,
+                               const std::vector<double>& deficits, double tolerance, int rings,
+                               int max_targets) {
   ConeCandidates out;
-  std::vector<int> valence(layout.nodes.size(), 0);
-  for (const auto& a : layout.arcs)
-    for (int id : {a.from, a.to})
-      if (const int n = layout.node_index(id); n >= 0) ++valence[n];
   const double tol = tolerance * M_PI / 2;
   std::vector<int> seen(original.n_vertices(), -1);
   for (int n : nodes) {

@@ -87,10 +87,12 @@ struct ConeCandidates {
 //! A vertex fits a node of index ι ≠ 0 when |deficit − 2πι| ≤ tolerance · π/2 (nodes of index
 //! 0 have no candidates, so smooth meshes have none). Searches \p rings rings of the original
 //! mesh around each of \p nodes (indices into layout.nodes) and keeps at most \p max_targets
-//! per node. \p deficits: vertex_angle_deficits(original).
+//! per node. \p valence: per node of the layout (LayoutTopology::valence); \p deficits:
+//! vertex_angle_deficits(original).
 ConeCandidates cone_candidates(const TriMesh& original, const TriMesh& mesh, const Layout& layout,
-                               const std::vector<int>& nodes, const std::vector<double>& deficits,
-                               double tolerance, int rings, int max_targets);
+                               const std::vector<int>& nodes, const std::vector<int>& valence,
+                               const std::vector<double>& deficits, double tolerance, int rings,
+                               int max_targets);
 
 //! One Gauss–Seidel sweep of discrete hops. Each node of \p nodes (indices into layout.nodes), in
 //! order, tries its free neighbouring vertices w (not forbidden_relocation_vertices): the node

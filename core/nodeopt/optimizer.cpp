@@ -226,7 +226,20 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     HopSweepResult h;
     h.E = current.E;
     h.foldovers = current.foldovers;
-    // One sweep over \p nodes of hopped (most strained first), accumulated into h.
+    // One hop_sweep of hopped, its result accumulated into h (evaluations too when the sweep
+    // draws on the neighbour hops' budget).
+    auto run_sweep = [&](const std::vector<int>& nodes, const std::vector<Vec3>& directions,
+                         HopSweepOptions sweep, bool counts_evaluations) {
+      sweep.relocation = no.relocation;
+      if (nodes.empty() || sweep.max_evaluations <= 0) return;
+      const HopSweepResult s = hop_sweep(original, hopped.mesh, hopped.layout, nodes, directions,
+                                         h.E, h.foldovers, sweep, evaluate, observer, &reroute);
+      h.moved += s.moved;
+      if (counts_evaluations) h.evaluations += s.evaluations;
+      h.E = s.E;
+      h.foldovers = s.foldovers;
+    };
+    // The relocated nodes (most strained first), each towards its relocation offset.
     auto sweep_nodes = [&](double min_offset, HopSweepOptions sweep) {
       std::vector<std::pair<double, int>> strained;  // (−offset, node)
       for (int n : movable) {
@@ -242,23 +255,17 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
         nodes.push_back(n);
         directions.push_back(hopped.mesh.point(vh) - original.point(vh));
       }
-      sweep.relocation = no.relocation;
       sweep.max_evaluations = no.hop_max_evaluations - h.evaluations;
-      if (nodes.empty() || sweep.max_evaluations <= 0) return;
-      const HopSweepResult s = hop_sweep(original, hopped.mesh, hopped.layout, nodes, directions,
-                                         h.E, h.foldovers, sweep, evaluate, observer, &reroute);
-      h.moved += s.moved;
-      h.evaluations += s.evaluations;
-      h.E = s.E;
-      h.foldovers = s.foldovers;
+      run_sweep(nodes, directions, sweep, true);
     };
     // Sharp cone vertices (discrete.h cone_candidates; none on smooth meshes).
     ConeCandidates cones;
     auto find_cones = [&]() {
       if (!no.hop_cones) return;
       if (deficits.empty()) deficits = vertex_angle_deficits(original_geometry);
-      cones = cone_candidates(original, hopped.mesh, hopped.layout, movable, deficits,
-                              no.hop_cone_tolerance, no.hop_cone_rings, no.hop_cone_targets);
+      cones = cone_candidates(original, hopped.mesh, hopped.layout, movable,
+                              current.pipeline->topology().valence, deficits, no.hop_cone_tolerance,
+                              no.hop_cone_rings, no.hop_cone_targets);
     };
     find_cones();
     if (cones_only && cones.hop_nodes.empty() && cones.snap_nodes.empty()) return false;
@@ -298,15 +305,9 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     // Then one node at a time (own budget): relocations off a fitting cone undone, and hops
     // onto a fitting cone nearby.
     auto cone_sweep = [&](const std::vector<int>& nodes, HopSweepOptions sweep) {
-      sweep.relocation = no.relocation;
       sweep.max_evaluations = no.hop_cone_max_evaluations;
       sweep.max_failures = no.hop_cone_max_failures;
-      if (nodes.empty()) return;
-      const HopSweepResult s = hop_sweep(original, hopped.mesh, hopped.layout, nodes, {}, h.E,
-                                         h.foldovers, sweep, evaluate, observer, &reroute);
-      h.moved += s.moved;
-      h.E = s.E;
-      h.foldovers = s.foldovers;
+      run_sweep(nodes, {}, sweep, false);
     };
     {
       HopSweepOptions snap;
