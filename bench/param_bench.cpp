@@ -2,7 +2,8 @@
 // rows, exact elimination, reduced-matrix patterns, analysis, factorization, solve) and traces
 // the layout's arcs on the result (extract_layout), on a mesh and layout, and compares the stage
 // with one stand-alone CHOLMOD numeric factorization + solve of the same reduced matrix measured
-// in the same run. Not a test.
+// in the same run (through SpdSolver reading the upper triangle, as the stage does: the first
+// factorization after its own analysis, like the stage's). Not a test.
 //
 //   qs_param_bench --mesh M --layout L [--repeat N] [--detail]
 //
@@ -10,7 +11,8 @@
 // patterns) and CHOLMOD's symbolic analysis of the reduced matrix with its orderings: the
 // default (AMD, METIS when AMD fills a lot), AMD only, METIS only, and AMD on the wedge quotient
 // graph (grouped_amd_ordering, used by ParamOptions::wedge_ordering) with nnz(L) and the numeric
-// factorization + solve time of each (best of 3).
+// factorization + solve time of each (best of 3), and the unit's factorization + solve (best of
+// 3) reading the upper and the lower triangle.
 //
 // Run with OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 OMP_THREAD_LIMIT=1 for CPU times that a
 // loaded machine does not inflate (Debian's CHOLMOD starts 4 OpenMP threads otherwise, and
@@ -26,6 +28,7 @@
 #include <vector>
 
 #include "bench/bench_util.h"
+#include "core/base/spd_solver.h"
 #include "core/extract/tracing.h"
 #include "core/layout/layout_io.h"
 #include "core/mesh/mesh_io.h"
@@ -133,14 +136,35 @@ int main(int argc, char** argv) {
       assembly.reduce();
       Eigen::SparseMatrix<double> A = assembly.A();
       for (int k = 0; k < A.cols(); ++k) A.coeffRef(k, k) += 1.0;  // SPD, same pattern
-      Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+      // Read as the stage reads it (SpdSolver, upper triangle: one permuted transpose less).
+      qs::SpdSolver llt = qs::full_storage_solver("unit");
       double c1 = cpu_seconds();
-      llt.analyzePattern(A);
+      llt.analyze(A);
       const double analyze = cpu_seconds() - c1;
       c1 = cpu_seconds();
       llt.factorize(A);
-      const Eigen::VectorXd x = llt.solve(Eigen::VectorXd::Ones(A.rows()));
+      const Eigen::VectorXd x = llt.solve(Eigen::VectorXd(Eigen::VectorXd::Ones(A.rows())));
       const double unit = cpu_seconds() - c1;
+      if (detail) {  // the same with the lower triangle (Eigen's default view)
+        Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> lower;
+        lower.analyzePattern(A);
+        double best = 1e30;
+        for (int k = 0; k < 3; ++k) {
+          const double c2 = cpu_seconds();
+          lower.factorize(A);
+          const Eigen::VectorXd xl = lower.solve(Eigen::VectorXd::Ones(A.rows()));
+          best = std::min(best, cpu_seconds() - c2);
+        }
+        double best_upper = 1e30;
+        for (int k = 0; k < 3; ++k) {
+          const double c2 = cpu_seconds();
+          llt.factorize(A);
+          const Eigen::VectorXd xu = llt.solve(Eigen::VectorXd(Eigen::VectorXd::Ones(A.rows())));
+          best_upper = std::min(best_upper, cpu_seconds() - c2);
+        }
+        std::printf("  unit factorize+solve, best of 3: upper triangle %.4f, lower %.4f\n",
+                    best_upper, best);
+      }
       std::printf(
           "stage %.4f = solver %.4f (setup %.4f assemble %.4f analyze %.4f factorize %.4f "
           "solve %.4f wall) + trace %.4f; unit %.4f (analyze %.4f) ratio %.2f | unknowns %d "

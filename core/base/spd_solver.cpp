@@ -43,11 +43,37 @@ class SupernodalLlt
     m_info = from.m_info;
     return true;
   }
+  //! The view of \p A that CHOLMOD reads: its upper triangle (stype 1) when \p upper, else its
+  //! lower triangle (stype −1).
+  static cholmod_sparse view(const Eigen::SparseMatrix<double>& A, bool upper) {
+    return upper ? Eigen::viewAsCholmod(A.selfadjointView<Eigen::Upper>())
+                 : Eigen::viewAsCholmod(A.selfadjointView<Eigen::Lower>());
+  }
+  //! Symbolic analysis (AMD/METIS as CHOLMOD's defaults choose) of the triangle \p upper says.
+  void analyze_triangle(const Eigen::SparseMatrix<double>& A, bool upper) {
+    if (m_cholmodFactor != nullptr) cholmod_free_factor(&m_cholmodFactor, &cholmod());
+    cholmod_sparse a = view(A, upper);
+    m_cholmodFactor = cholmod_analyze(&a, &cholmod());
+    m_isInitialized = true;
+    m_info = m_cholmodFactor != nullptr ? Eigen::Success : Eigen::NumericalIssue;
+    m_analysisIsOk = m_cholmodFactor != nullptr;
+    m_factorizationIsOk = false;
+  }
+  //! Numeric factorization of the triangle \p upper says. With the upper triangle CHOLMOD forms
+  //! tril(PAPᵀ) with one permuted transpose; with the lower one it needs two.
+  void factorize_triangle(const Eigen::SparseMatrix<double>& A, bool upper) {
+    cholmod_sparse a = view(A, upper);
+    double beta[2] = {0, 0};
+    cholmod_factorize_p(&a, beta, nullptr, 0, m_cholmodFactor, &cholmod());
+    m_info = m_cholmodFactor->minor == m_cholmodFactor->n ? Eigen::Success : Eigen::NumericalIssue;
+    m_factorizationIsOk = true;
+  }
   //! Symbolic analysis with the fill-reducing ordering \p perm (size n, perm[k] = the column
   //! eliminated k-th) instead of AMD/METIS; CHOLMOD still postorders its elimination tree.
-  void analyze_with_ordering(const Eigen::SparseMatrix<double>& A, std::vector<int>& perm) {
+  void analyze_with_ordering(const Eigen::SparseMatrix<double>& A, bool upper,
+                             std::vector<int>& perm) {
     if (m_cholmodFactor != nullptr) cholmod_free_factor(&m_cholmodFactor, &cholmod());
-    cholmod_sparse a = Eigen::viewAsCholmod(A.selfadjointView<Eigen::Lower>());
+    cholmod_sparse a = view(A, upper);
     cholmod_common& c = cholmod();
     const int nmethods = c.nmethods, ordering = c.method[0].ordering;
     c.nmethods = 1;
@@ -78,6 +104,7 @@ struct SpdSolver::Impl {
   std::vector<int> outer, inner;  // pattern of the analyzed matrix (compressed)
   bool analyzed = false;
   bool factorized = false;
+  bool upper = false;  // the analysis and factorizations read A's upper triangle
 };
 
 SpdSolver::SpdSolver(std::string stage)
@@ -97,6 +124,7 @@ void SpdSolver::detach(bool keep_analysis) {
     own->outer = impl_->outer;
     own->inner = impl_->inner;
     own->analyzed = true;
+    own->upper = impl_->upper;
   }
   impl_ = std::move(own);
 }
@@ -112,6 +140,7 @@ void SpdSolver::unshare() {
   own->inner = impl_->inner;
   own->analyzed = impl_->analyzed;
   own->factorized = impl_->factorized;
+  own->upper = impl_->upper;
   impl_ = std::move(own);
 }
 
@@ -123,10 +152,10 @@ void SpdSolver::analyze(const Eigen::SparseMatrix<double>& A) {
   std::vector<int> hint = std::move(ordering_hint_);
   ordering_hint_.clear();
   if (static_cast<Eigen::Index>(hint.size()) == A.rows() && A.rows() > 0) {
-    impl_->llt.analyze_with_ordering(A, hint);
+    impl_->llt.analyze_with_ordering(A, full_storage_, hint);
     ++stats_.hinted_analyses;
   } else {
-    impl_->llt.analyzePattern(A);
+    impl_->llt.analyze_triangle(A, full_storage_);
   }
   if (impl_->llt.info() != Eigen::Success)
     throw SolverError(stage_ + ": symbolic analysis failed (" + std::to_string(A.rows()) +
@@ -142,13 +171,14 @@ void SpdSolver::analyze(const Eigen::SparseMatrix<double>& A) {
   }
   impl_->analyzed = true;
   impl_->factorized = false;
+  impl_->upper = full_storage_;
   stats_.analyze_s = seconds_since(t0);
   ++stats_.analyses;
 }
 
 void SpdSolver::factorize(const Eigen::SparseMatrix<double>& A) {
   limit_solver_threads_here();  // CHOLMOD's OpenMP regions (solver_threads.h)
-  if (!same_pattern(A))
+  if (!same_pattern(A) || impl_->upper != full_storage_)
     analyze(A);
   else
     detach(true);  // a copy keeps the shared factorization
@@ -158,7 +188,7 @@ void SpdSolver::factorize(const Eigen::SparseMatrix<double>& A) {
                         " unknowns)");
   }
   const auto t0 = std::chrono::steady_clock::now();
-  impl_->llt.factorize(A);
+  impl_->llt.factorize_triangle(A, impl_->upper);
   impl_->factorized = impl_->llt.info() == Eigen::Success;
   if (!impl_->factorized)
     throw SolverError(stage_ + ": matrix is not positive definite (" + std::to_string(A.rows()) +
@@ -202,6 +232,7 @@ bool SpdSolver::copy_analysis_from(const SpdSolver& other) {
   impl_->outer = other.impl_->outer;
   impl_->inner = other.impl_->inner;
   impl_->analyzed = true;
+  impl_->upper = other.impl_->upper;
   impl_->factorized = false;
   stats_.analyze_s = seconds_since(t0);
   return true;

@@ -31,7 +31,15 @@ class SpdSolver {
   SpdSolver(SpdSolver&&) noexcept;
   SpdSolver& operator=(SpdSolver&&) noexcept;
 
-  //! Symbolic analysis of the pattern of \p A (symmetric; the lower triangle is used).
+  //! \p full: the matrices this solver gets store both triangles (exactly symmetric values):
+  //! CHOLMOD then reads the upper triangle, which saves one permuted transpose of A in every
+  //! numeric factorization. Default false: only the lower triangle is read (the upper may be
+  //! absent). Takes effect at the next analysis.
+  void set_full_storage(bool full) { full_storage_ = full; }
+  bool full_storage() const { return full_storage_; }
+
+  //! Symbolic analysis of the pattern of \p A (symmetric; the lower triangle is used, or the
+  //! upper one with set_full_storage).
   void analyze(const Eigen::SparseMatrix<double>& A);
   //! Numeric factorization. Analyzes first unless the last analysis was of exactly this
   //! sparsity pattern (same size, same column starts and row indices; checked in O(nnz)), so a
@@ -76,6 +84,7 @@ class SpdSolver {
   std::string stage_;
   SpdSolverStats stats_;
   std::vector<int> ordering_hint_;  //!< for the next analysis (set_ordering_hint)
+  bool full_storage_ = false;       //!< set_full_storage
 };
 
 //! A fill-reducing ordering of the symmetric \p A (both triangles stored, as
@@ -89,5 +98,12 @@ class SpdSolver {
 //! does not fit A or AMD fails.
 std::vector<int> grouped_amd_ordering(const Eigen::SparseMatrix<double>& A,
                                       const std::vector<int>& group);
+
+//! A solver with set_full_storage(true), for matrices that store both triangles.
+inline SpdSolver full_storage_solver(std::string stage) {
+  SpdSolver solver(std::move(stage));
+  solver.set_full_storage(true);
+  return solver;
+}
 
 }  // namespace qs

@@ -133,7 +133,8 @@ class ParamSolver {
   ConstraintSystem system_;
   Reduction reduction_;
   ReducedAssembly assembly_;  //!< fixed patterns of H and A = ZᵀHZ (built with reduction_)
-  SpdSolver solver_{"parameterization"};
+  //! Reads the upper triangle of A (ReducedAssembly stores both): SpdSolver::set_full_storage.
+  SpdSolver solver_ = full_storage_solver("parameterization");
   //! The sizing field's solver (ParamOptions::sizing.enabled), built at the first solve.
   std::unique_ptr<SizingSolver> sizing_;
   Parameterization result_;
