@@ -16,6 +16,13 @@ inline double cpu_seconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
+//! Monotonic wall-clock seconds (CLOCK_MONOTONIC): what a user waits, threads overlapping.
+inline double wall_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
 //! Median (upper median for an even count; 0 for none).
 inline double median(std::vector<double> v) {
   if (v.empty()) return 0;

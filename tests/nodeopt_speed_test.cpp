@@ -121,42 +121,6 @@ TEST(SpdSolverReuse, OrderingHintGivesTheSameSolution) {
   EXPECT_LT((B * small.solve(b) - b).norm(), 1e-10 * b.norm());
 }
 
-// set_full_storage: the solver reads the upper triangle (else the lower one). A matrix whose
-// strict lower triangle differs from its upper one tells which triangle was read.
-TEST(SpdSolverReuse, FullStorageReadsTheUpperTriangle) {
-  const auto A = grid_laplacian(12, 0.5);
-  Eigen::SparseMatrix<double> skewed = A;  // lower triangle scaled: A's upper, another lower
-  for (int k = 0; k < skewed.outerSize(); ++k)
-    for (Eigen::SparseMatrix<double>::InnerIterator it(skewed, k); it; ++it)
-      if (it.row() > it.col()) it.valueRef() *= 0.5;
-  const Eigen::SparseMatrix<double> from_upper =
-      Eigen::SparseMatrix<double>(skewed.selfadjointView<Eigen::Upper>());
-  const Eigen::SparseMatrix<double> from_lower =
-      Eigen::SparseMatrix<double>(skewed.selfadjointView<Eigen::Lower>());
-  const Eigen::VectorXd b = random_rhs(static_cast<int>(A.rows()), 3);
-  SpdSolver full = full_storage_solver("full");
-  EXPECT_TRUE(full.full_storage());
-  full.factorize(skewed);
-  EXPECT_LT((from_upper * full.solve(b) - b).norm(), 1e-10 * b.norm());
-  SpdSolver lower("lower");
-  EXPECT_FALSE(lower.full_storage());
-  lower.factorize(skewed);
-  EXPECT_LT((from_lower * lower.solve(b) - b).norm(), 1e-10 * b.norm());
-  // Switching the storage re-analyzes (same pattern), and a copy keeps the setting.
-  SpdSolver copy = full;
-  EXPECT_TRUE(copy.full_storage());
-  lower.set_full_storage(true);
-  const int analyses = lower.stats().analyses;
-  lower.factorize(skewed);
-  EXPECT_EQ(lower.stats().analyses, analyses + 1);
-  EXPECT_LT((from_upper * lower.solve(b) - b).norm(), 1e-10 * b.norm());
-  // On an exactly symmetric matrix both read the same system.
-  full.factorize(A);
-  SpdSolver plain("plain");
-  plain.factorize(A);
-  EXPECT_LT((full.solve(b) - plain.solve(b)).norm(), 1e-12 * plain.solve(b).norm());
-}
-
 using Example = test::MeshAndLayout;
 using test::ellipsoid_example;
 

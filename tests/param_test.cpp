@@ -180,5 +180,26 @@ TEST(Parameterization, WedgeOrderingIsUsedAndGivesTheSameSolution) {
   EXPECT_NEAR(a.param->result().energy, b.param->result().energy, 1e-9 * a.param->result().energy);
 }
 
+// ParamOptions::second_thread (labels beside the cut graph, the analysis beside the assembly)
+// changes nothing in the results: bit-identical corner values, energy and labels, with and
+// without the sizing field (its solve is part of the assembly the analysis overlaps).
+TEST(Parameterization, SecondThreadGivesIdenticalResults) {
+  const auto in = test::cube_sphere(8);
+  for (const bool sizing : {false, true}) {
+    ParamOptions one, two;
+    one.second_thread = false;
+    two.second_thread = true;
+    one.sizing.enabled = two.sizing.enabled = sizing;
+    const Solved a = solve_all(in, one), b = solve_all(in, two);
+    EXPECT_EQ(a.param->result().corner_uv, b.param->result().corner_uv) << "sizing " << sizing;
+    EXPECT_EQ(a.param->result().energy, b.param->result().energy);
+    EXPECT_EQ(a.param->labeling().chart_face, b.param->labeling().chart_face);
+    EXPECT_EQ(a.param->cut_graph().corner_wedge, b.param->cut_graph().corner_wedge);
+    EXPECT_EQ(b.param->linear_solver().stats().analyses, 1);
+    EXPECT_EQ(b.param->linear_solver().stats().factorizations, 1);
+    EXPECT_GT(b.param->linear_solver().stats().analyze_s, 0);
+  }
+}
+
 }  // namespace
 }  // namespace qs

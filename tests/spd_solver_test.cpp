@@ -211,5 +211,91 @@ TEST(SpdSolver, UnsharedCopySolvesConcurrently) {
   EXPECT_EQ(original.solve(b), expected);
 }
 
+// begin_analysis: the analysis of A's pattern runs on another thread while the caller writes A's
+// values (it reads the pattern only); the factorization then needs no analysis of its own and
+// solves exactly as a synchronous analysis would. Run under TSan in CI.
+TEST(SpdSolver, BackgroundAnalysisWhileTheValuesAreWritten) {
+  const auto target = grid_matrix(40, 0.05, 2.0);
+  const Eigen::VectorXd b = random_vector(static_cast<int>(target.rows()), 11);
+  Eigen::SparseMatrix<double> A = target;
+  std::fill(A.valuePtr(), A.valuePtr() + A.nonZeros(), 0.0);  // values come later
+  SpdSolver background("background");
+  background.begin_analysis(A);
+  for (Eigen::Index k = 0; k < A.nonZeros(); ++k) A.valuePtr()[k] = target.valuePtr()[k];
+  background.factorize(A);
+  EXPECT_EQ(background.stats().analyses, 1);
+  EXPECT_EQ(background.stats().factorizations, 1);
+  SpdSolver reference("reference");
+  reference.factorize(target);
+  EXPECT_EQ(background.ordering(), reference.ordering());
+  const Eigen::VectorXd x = background.solve(b);
+  EXPECT_LT(relative_residual(target, x, b), 1e-10);
+  EXPECT_EQ(x, reference.solve(b));  // the same analysis and factorization, bit for bit
+  // The analyzed pattern again: nothing starts, nothing is counted.
+  background.begin_analysis(A);
+  background.factorize(A);
+  EXPECT_EQ(background.stats().analyses, 1);
+  // Another pattern: counted once collected, with the full-storage setting of the solver.
+  const auto B = grid_matrix(41, 0.05);
+  background.set_full_storage(true);
+  background.begin_analysis(B);
+  EXPECT_TRUE(background.same_pattern(B));  // waits for the analysis
+  background.factorize(B);
+  EXPECT_EQ(background.stats().analyses, 2);
+  const Eigen::VectorXd c = random_vector(static_cast<int>(B.rows()), 12);
+  EXPECT_LT(relative_residual(B, background.solve(c), c), 1e-10);
+  // Errors: a non-square matrix at once; a solver dropped or copied mid-analysis waits for it.
+  EXPECT_THROW(background.begin_analysis(Eigen::SparseMatrix<double>(3, 4)), SolverError);
+  {
+    SpdSolver dropped("dropped");
+    dropped.begin_analysis(B);
+  }
+  SpdSolver source("source");
+  source.begin_analysis(B);
+  SpdSolver copy = source;
+  copy.wait_for_analysis();
+  EXPECT_TRUE(copy.same_pattern(B));
+  copy.factorize(B);
+  EXPECT_LT(relative_residual(B, copy.solve(c), c), 1e-10);
+  source.factorize(B);  // the source keeps its own analysis
+  EXPECT_LT(relative_residual(B, source.solve(c), c), 1e-10);
+}
+
+// set_full_storage: the solver reads the upper triangle (else the lower one). A matrix whose
+// strict lower triangle differs from its upper one tells which triangle was read.
+TEST(SpdSolver, FullStorageReadsTheUpperTriangle) {
+  const auto A = grid_matrix(12, 0.5);
+  Eigen::SparseMatrix<double> skewed = A;  // lower triangle scaled: A's upper, another lower
+  for (int k = 0; k < skewed.outerSize(); ++k)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(skewed, k); it; ++it)
+      if (it.row() > it.col()) it.valueRef() *= 0.5;
+  const Eigen::SparseMatrix<double> from_upper =
+      Eigen::SparseMatrix<double>(skewed.selfadjointView<Eigen::Upper>());
+  const Eigen::SparseMatrix<double> from_lower =
+      Eigen::SparseMatrix<double>(skewed.selfadjointView<Eigen::Lower>());
+  const Eigen::VectorXd b = random_vector(static_cast<int>(A.rows()), 3);
+  SpdSolver full = full_storage_solver("full");
+  EXPECT_TRUE(full.full_storage());
+  full.factorize(skewed);
+  EXPECT_LT(relative_residual(from_upper, full.solve(b), b), 1e-10);
+  SpdSolver lower("lower");
+  EXPECT_FALSE(lower.full_storage());
+  lower.factorize(skewed);
+  EXPECT_LT(relative_residual(from_lower, lower.solve(b), b), 1e-10);
+  // Switching the storage re-analyzes (same pattern), and a copy keeps the setting.
+  SpdSolver copy = full;
+  EXPECT_TRUE(copy.full_storage());
+  lower.set_full_storage(true);
+  const int analyses = lower.stats().analyses;
+  lower.factorize(skewed);
+  EXPECT_EQ(lower.stats().analyses, analyses + 1);
+  EXPECT_LT(relative_residual(from_upper, lower.solve(b), b), 1e-10);
+  // On an exactly symmetric matrix both read the same system.
+  full.factorize(A);
+  SpdSolver plain("plain");
+  plain.factorize(A);
+  EXPECT_LT((full.solve(b) - plain.solve(b)).norm(), 1e-12 * plain.solve(b).norm());
+}
+
 }  // namespace
 }  // namespace qs

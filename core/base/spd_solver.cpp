@@ -3,6 +3,7 @@
 #include <Eigen/CholmodSupport>
 #include <algorithm>
 #include <chrono>
+#include <future>
 #include <numeric>
 #include <vector>
 
@@ -49,10 +50,18 @@ class SupernodalLlt
     return upper ? Eigen::viewAsCholmod(A.selfadjointView<Eigen::Upper>())
                  : Eigen::viewAsCholmod(A.selfadjointView<Eigen::Lower>());
   }
+  //! The same view without the values (an analysis reads the pattern only, so another thread
+  //! may write A's values meanwhile: SpdSolver::begin_analysis).
+  static cholmod_sparse pattern_view(const Eigen::SparseMatrix<double>& A, bool upper) {
+    cholmod_sparse a = view(A, upper);
+    a.xtype = CHOLMOD_PATTERN;
+    a.x = nullptr;
+    return a;
+  }
   //! Symbolic analysis (AMD/METIS as CHOLMOD's defaults choose) of the triangle \p upper says.
   void analyze_triangle(const Eigen::SparseMatrix<double>& A, bool upper) {
     if (m_cholmodFactor != nullptr) cholmod_free_factor(&m_cholmodFactor, &cholmod());
-    cholmod_sparse a = view(A, upper);
+    cholmod_sparse a = pattern_view(A, upper);
     m_cholmodFactor = cholmod_analyze(&a, &cholmod());
     m_isInitialized = true;
     m_info = m_cholmodFactor != nullptr ? Eigen::Success : Eigen::NumericalIssue;
@@ -73,7 +82,7 @@ class SupernodalLlt
   void analyze_with_ordering(const Eigen::SparseMatrix<double>& A, bool upper,
                              std::vector<int>& perm) {
     if (m_cholmodFactor != nullptr) cholmod_free_factor(&m_cholmodFactor, &cholmod());
-    cholmod_sparse a = view(A, upper);
+    cholmod_sparse a = pattern_view(A, upper);
     cholmod_common& c = cholmod();
     const int nmethods = c.nmethods, ordering = c.method[0].ordering;
     c.nmethods = 1;
@@ -105,7 +114,46 @@ struct SpdSolver::Impl {
   bool analyzed = false;
   bool factorized = false;
   bool upper = false;  // the analysis and factorizations read A's upper triangle
+  // An analysis running on another thread (begin_analysis). Declared last: destroying an Impl
+  // first waits for it (std::async's future), before the factor it writes is freed.
+  std::future<AnalysisResult> pending;
+
+  //! Waits for a pending analysis (without taking its result).
+  void wait() const {
+    if (pending.valid()) pending.wait();
+  }
 };
+
+SpdSolver::AnalysisResult SpdSolver::run_analysis(Impl& impl, const Eigen::SparseMatrix<double>& A,
+                                                  bool upper, std::vector<int> hint,
+                                                  const std::string& stage) {
+  const auto t0 = std::chrono::steady_clock::now();
+  SpdSolver::AnalysisResult result;
+  impl.analyzed = false;
+  impl.factorized = false;
+  if (static_cast<Eigen::Index>(hint.size()) == A.rows() && A.rows() > 0) {
+    impl.llt.analyze_with_ordering(A, upper, hint);
+    result.hinted = true;
+  } else {
+    impl.llt.analyze_triangle(A, upper);
+  }
+  if (impl.llt.info() != Eigen::Success)
+    throw SolverError(stage + ": symbolic analysis failed (" + std::to_string(A.rows()) +
+                      " unknowns)");
+  impl.rows = A.rows();
+  impl.nnz = A.nonZeros();
+  if (A.isCompressed()) {
+    impl.outer.assign(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1);
+    impl.inner.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
+  } else {
+    impl.outer.clear();  // never matches: an uncompressed matrix is always re-analyzed
+    impl.inner.clear();
+  }
+  impl.analyzed = true;
+  impl.upper = upper;
+  result.seconds = seconds_since(t0);
+  return result;
+}
 
 SpdSolver::SpdSolver(std::string stage)
     : impl_(std::make_shared<Impl>()), stage_(std::move(stage)) {}
@@ -130,6 +178,7 @@ void SpdSolver::detach(bool keep_analysis) {
 }
 
 void SpdSolver::unshare() {
+  collect_analysis();
   if (impl_.use_count() <= 1) return;
   auto own = std::make_shared<Impl>();
   if (impl_->analyzed && !own->llt.copy_factor_from(impl_->llt))
@@ -145,38 +194,52 @@ void SpdSolver::unshare() {
 }
 
 void SpdSolver::analyze(const Eigen::SparseMatrix<double>& A) {
+  collect_analysis();
   if (A.rows() != A.cols()) throw SolverError(stage_ + ": matrix is not square");
   limit_solver_threads_here();
   detach(false);
-  const auto t0 = std::chrono::steady_clock::now();
   std::vector<int> hint = std::move(ordering_hint_);
   ordering_hint_.clear();
-  if (static_cast<Eigen::Index>(hint.size()) == A.rows() && A.rows() > 0) {
-    impl_->llt.analyze_with_ordering(A, full_storage_, hint);
-    ++stats_.hinted_analyses;
-  } else {
-    impl_->llt.analyze_triangle(A, full_storage_);
-  }
-  if (impl_->llt.info() != Eigen::Success)
-    throw SolverError(stage_ + ": symbolic analysis failed (" + std::to_string(A.rows()) +
-                      " unknowns)");
-  impl_->rows = A.rows();
-  impl_->nnz = A.nonZeros();
-  if (A.isCompressed()) {
-    impl_->outer.assign(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1);
-    impl_->inner.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
-  } else {
-    impl_->outer.clear();  // never matches: an uncompressed matrix is always re-analyzed
-    impl_->inner.clear();
-  }
-  impl_->analyzed = true;
-  impl_->factorized = false;
-  impl_->upper = full_storage_;
-  stats_.analyze_s = seconds_since(t0);
+  note_analysis(run_analysis(*impl_, A, full_storage_, std::move(hint), stage_));
+}
+
+void SpdSolver::begin_analysis(const Eigen::SparseMatrix<double>& A) {
+  collect_analysis();
+  if (A.rows() != A.cols()) throw SolverError(stage_ + ": matrix is not square");
+  if (same_pattern(A) && impl_->upper == full_storage_) return;
+  detach(false);
+  std::vector<int> hint = std::move(ordering_hint_);
+  ordering_hint_.clear();
+  // impl_ stays alive and in place until the result is collected: every member that touches it
+  // waits first, and an Impl's destruction waits for its pending analysis.
+  Impl* impl = impl_.get();
+  impl->analyzed = false;
+  impl->factorized = false;
+  impl->pending = std::async(std::launch::async, [impl, &A, upper = full_storage_,
+                                                  hint = std::move(hint), stage = stage_]() {
+    limit_solver_threads_here();
+    return run_analysis(*impl, A, upper, hint, stage);
+  });
+}
+
+void SpdSolver::wait_for_analysis() const noexcept {
+  impl_->wait();
+}
+
+void SpdSolver::collect_analysis() {
+  if (!impl_->pending.valid()) return;
+  std::future<AnalysisResult> pending = std::move(impl_->pending);
+  note_analysis(pending.get());  // rethrows the analysis' SolverError
+}
+
+void SpdSolver::note_analysis(const AnalysisResult& result) {
+  stats_.analyze_s = result.seconds;
   ++stats_.analyses;
+  stats_.hinted_analyses += result.hinted;
 }
 
 void SpdSolver::factorize(const Eigen::SparseMatrix<double>& A) {
+  collect_analysis();
   limit_solver_threads_here();  // CHOLMOD's OpenMP regions (solver_threads.h)
   if (!same_pattern(A) || impl_->upper != full_storage_)
     analyze(A);
@@ -198,6 +261,7 @@ void SpdSolver::factorize(const Eigen::SparseMatrix<double>& A) {
 }
 
 Eigen::VectorXd SpdSolver::solve(const Eigen::VectorXd& b) {
+  collect_analysis();
   if (!impl_->factorized) throw SolverError(stage_ + ": solve called before a factorization");
   if (!b.allFinite()) throw SolverError(stage_ + ": right-hand side has non-finite entries");
   const auto t0 = std::chrono::steady_clock::now();
@@ -211,6 +275,7 @@ Eigen::VectorXd SpdSolver::solve(const Eigen::VectorXd& b) {
 }
 
 Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& B) {
+  collect_analysis();
   if (!impl_->factorized) throw SolverError(stage_ + ": solve called before a factorization");
   if (!B.allFinite()) throw SolverError(stage_ + ": right-hand side has non-finite entries");
   const auto t0 = std::chrono::steady_clock::now();
@@ -223,6 +288,8 @@ Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& B) {
 }
 
 bool SpdSolver::copy_analysis_from(const SpdSolver& other) {
+  collect_analysis();
+  other.impl_->wait();
   if (this == &other || !other.impl_->analyzed || other.impl_->outer.empty()) return false;
   const auto t0 = std::chrono::steady_clock::now();
   detach(false);
@@ -239,6 +306,7 @@ bool SpdSolver::copy_analysis_from(const SpdSolver& other) {
 }
 
 bool SpdSolver::same_pattern(const Eigen::SparseMatrix<double>& A) const {
+  impl_->wait();
   if (!impl_->analyzed || A.rows() != impl_->rows || A.cols() != impl_->rows ||
       A.nonZeros() != impl_->nnz || !A.isCompressed() ||
       impl_->outer.size() != static_cast<size_t>(A.outerSize()) + 1)
@@ -248,10 +316,12 @@ bool SpdSolver::same_pattern(const Eigen::SparseMatrix<double>& A) const {
 }
 
 bool SpdSolver::factorized() const {
+  impl_->wait();
   return impl_->factorized;
 }
 
 std::vector<int> SpdSolver::ordering() const {
+  impl_->wait();
   return impl_->analyzed ? impl_->llt.ordering() : std::vector<int>{};
 }
 

@@ -41,6 +41,16 @@ class SpdSolver {
   //! Symbolic analysis of the pattern of \p A (symmetric; the lower triangle is used, or the
   //! upper one with set_full_storage).
   void analyze(const Eigen::SparseMatrix<double>& A);
+  //! Starts the symbolic analysis of \p A's pattern on another thread and returns at once (a
+  //! no-op when the last analysis was of this pattern), so the caller can fill A's values
+  //! meanwhile: the analysis reads the pattern only. Until the next call of any other member
+  //! (they wait for it), \p A must stay alive with its pattern (size, column starts, row
+  //! indices) unchanged. Analysis errors surface at that next call. Uses the ordering hint like
+  //! analyze().
+  void begin_analysis(const Eigen::SparseMatrix<double>& A);
+  //! Blocks until an analysis begun by begin_analysis has finished (its result and errors are
+  //! kept for the next call); for callers that must release A early, e.g. on an exception.
+  void wait_for_analysis() const noexcept;
   //! Numeric factorization. Analyzes first unless the last analysis was of exactly this
   //! sparsity pattern (same size, same column starts and row indices; checked in O(nnz)), so a
   //! solver handed on to a new system with an identical pattern keeps its analysis.
@@ -80,6 +90,18 @@ class SpdSolver {
   void detach(bool keep_analysis);
 
   struct Impl;
+  struct AnalysisResult {
+    double seconds = 0;
+    bool hinted = false;
+  };
+  //! The symbolic analysis of \p A into \p impl (its state replaced); \p hint: the ordering to
+  //! use (empty: CHOLMOD's). \throw SolverError when CHOLMOD fails.
+  static AnalysisResult run_analysis(Impl& impl, const Eigen::SparseMatrix<double>& A, bool upper,
+                                     std::vector<int> hint, const std::string& stage);
+  //! Waits for an analysis begun by begin_analysis and counts it in the stats (rethrows its
+  //! error); a no-op without one.
+  void collect_analysis();
+  void note_analysis(const AnalysisResult& result);
   std::shared_ptr<Impl> impl_;
   std::string stage_;
   SpdSolverStats stats_;

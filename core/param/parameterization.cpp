@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <sstream>
 #include <unordered_map>
 #include <utility>
@@ -143,8 +144,20 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
   std::vector<char> singular(g.n_vertices, 0);
   for (int n = 0; n < topo.num_nodes; ++n)
     if (topo.valence[n] != 4) singular[layout.nodes[n].vertex] = 1;
-  cut_ = build_cut_graph(mesh, g, p, singular);
-  labeling_ = label_layout(mesh, g, layout, topo, p, theta);
+  if (options_.second_thread) {  // independent: the labels on a second thread
+    auto labels = std::async(std::launch::async,
+                             [&]() { return label_layout(mesh, g, layout, topo, p, theta); });
+    try {
+      cut_ = build_cut_graph(mesh, g, p, singular);
+    } catch (...) {
+      labels.wait();
+      throw;
+    }
+    labeling_ = labels.get();
+  } else {
+    cut_ = build_cut_graph(mesh, g, p, singular);
+    labeling_ = label_layout(mesh, g, layout, topo, p, theta);
+  }
   system_.variables = 2 * cut_.wedges;
 
   auto add_row = [&](Terms terms, double rhs, int origin) {
@@ -432,6 +445,16 @@ const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCa
   // Targets e^{s_t} u_t, e^{s_t} v_t (sizing): only the right-hand side and the constant change.
   // The orientation constraints (solve_oriented) use the field's directions only, which the
   // scale does not change; their QP gets the sized b.
+  // A's pattern is fixed (ReducedAssembly): a new one is analyzed while the values are filled.
+  if (options_.second_thread) {
+    hint_ordering(assembly_.A());
+    solver_.begin_analysis(assembly_.A());
+  }
+  // Until factorize() collects it, the analysis reads A's pattern: wait for it on every exit.
+  struct WaitForAnalysis {
+    const SpdSolver& solver;
+    ~WaitForAnalysis() { solver.wait_for_analysis(); }
+  } wait_for_analysis{solver_};
   const std::vector<double> scale = target_scales(mesh, g, theta);
   assembly_.clear();
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
