@@ -6,11 +6,14 @@
 // factorization after its own analysis, like the stage's). Not a test.
 //
 //   qs_param_bench --mesh M --layout L [--repeat N] [--detail] [--one-thread]
+//                  [--one-thread-trace]
 //
 // Stage and unit are measured in process CPU seconds and in wall seconds. The stage labels the
 // layout beside the cut graph and analyzes the reduced matrix beside the energy assembly on a
-// second thread (ParamOptions::second_thread; --one-thread turns it off), so its wall time is
-// the one a user waits on two cores, and its CPU time counts both threads.
+// second thread (ParamOptions::second_thread; --one-thread turns it off), and traces half of
+// the arcs of large layouts on a second thread (TraceOptions::second_thread_arcs;
+// --one-thread-trace turns it off), so its wall time is the one a user waits on two cores, and
+// its CPU time counts both threads.
 // --detail adds, per repeat, the setup's parts (cut graph, labels, elimination, reduced-matrix
 // patterns) and CHOLMOD's symbolic analysis of the reduced matrix with its orderings: the
 // default (AMD, METIS when AMD fills a lot), AMD only, METIS only, and AMD on the wedge quotient
@@ -98,9 +101,11 @@ int main(int argc, char** argv) {
   int repeat = 3;
   bool detail = false;
   bool second_thread = true;
+  qs::TraceOptions trace_options;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--detail")) detail = true;
     if (!std::strcmp(argv[i], "--one-thread")) second_thread = false;
+    if (!std::strcmp(argv[i], "--one-thread-trace")) trace_options.second_thread_arcs = 0;
   }
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--mesh"))
@@ -131,11 +136,11 @@ int main(int argc, char** argv) {
                                    field.period_jump, field.theta, options.param);
       const double solve = cpu_seconds() - c0;
       const qs::Parameterization& res = solver.result();
-      const double t0 = cpu_seconds();
+      const double t0 = cpu_seconds(), tw0 = wall_seconds();
       const qs::Extraction ex =
           qs::extract_layout(p.mesh(), p.geometry(), p.layout(), p.topology(), solver.labeling(),
-                             field.period_jump, res.corner_uv);
-      const double trace = cpu_seconds() - t0;
+                             field.period_jump, res.corner_uv, trace_options);
+      const double trace = cpu_seconds() - t0, trace_wall = wall_seconds() - tw0;
       const double stage = solve + trace;
       const double stage_wall = wall_seconds() - w0;
       // The unit: the same reduced matrix, analyzed apart, then factorized and solved.
@@ -219,8 +224,8 @@ int main(int argc, char** argv) {
         std::printf("  wedge-grouped AMD ordering %.4f s CPU\n", t_order);
         analysis_variant("wedge AMD", A, 0, 0, &order, t_order);
       }
-      std::printf("  wall: stage %.4f, unit %.4f, ratio %.2f\n", stage_wall, unit_wall,
-                  stage_wall / unit_wall);
+      std::printf("  wall: stage %.4f (trace %.4f), unit %.4f, ratio %.2f\n", stage_wall,
+                  trace_wall, unit_wall, stage_wall / unit_wall);
       stages.push_back(stage);
       units.push_back(unit);
       ratios.push_back(stage / unit);

@@ -201,5 +201,33 @@ TEST(Parameterization, SecondThreadGivesIdenticalResults) {
   }
 }
 
+// TraceOptions::second_thread_arcs: tracing half of the arcs on a second thread gives the same
+// extraction as one thread (every sample, the problems in arc order, the equivalence).
+TEST(Parameterization, SecondThreadTracesTheSameArcs) {
+  for (const auto& in : {test::torus_grid(32, 16, 4, 2), test::cube_sphere(8)}) {
+    const Solved s = solve_all(in);
+    TraceOptions one, two;
+    one.second_thread_arcs = 0;
+    two.second_thread_arcs = 1;  // any layout
+    const auto& uv = s.param->result().corner_uv;
+    const Extraction a = extract_layout(in.mesh, s.geometry, in.layout, s.topology,
+                                        s.param->labeling(), s.field.period_jump, uv, one);
+    const Extraction b = extract_layout(in.mesh, s.geometry, in.layout, s.topology,
+                                        s.param->labeling(), s.field.period_jump, uv, two);
+    ASSERT_EQ(a.arcs.size(), b.arcs.size());
+    ASSERT_GT(a.arcs.size(), 1u);
+    for (size_t k = 0; k < a.arcs.size(); ++k) {
+      EXPECT_EQ(a.arcs[k].ok, b.arcs[k].ok) << "arc " << k;
+      EXPECT_EQ(a.arcs[k].polyline, b.arcs[k].polyline) << "arc " << k;
+      EXPECT_EQ(a.arcs[k].uv, b.arcs[k].uv) << "arc " << k;
+      EXPECT_EQ(a.arcs[k].param_length, b.arcs[k].param_length) << "arc " << k;
+    }
+    EXPECT_EQ(a.problems, b.problems);
+    EXPECT_EQ(a.crossings, b.crossings);
+    EXPECT_TRUE(a.structurally_equivalent);
+    EXPECT_EQ(a.structurally_equivalent, b.structurally_equivalent);
+  }
+}
+
 }  // namespace
 }  // namespace qs

@@ -1,6 +1,7 @@
 #include "core/extract/tracing.h"
 
 #include <cmath>
+#include <future>
 #include <limits>
 #include <vector>
 
@@ -376,17 +377,34 @@ Extraction extract_layout(const TriMesh& mesh, const GeometryCache& g, const Lay
   Extraction ex;
   std::vector<int> node_at(g.n_vertices, -1);
   for (int n = 0; n < topo.num_nodes; ++n) node_at[layout.nodes[n].vertex] = n;
-  Tracer tracer(mesh, g, p, uv, node_at, opt);
   ex.arcs.resize(topo.num_arcs);
-  for (int a = 0; a < topo.num_arcs; ++a) {
-    const int h = 2 * a;
-    const int start_node = topo.half_node[h];
-    const int end_node = topo.half_node[h + 1];
-    ex.arcs[a] = tracer.trace(layout.nodes[start_node].vertex, labeling.chart_face[h],
-                              labeling.symbol[h], end_node, start_node);
+  // Arcs [begin, end) (each traced independently: Tracer keeps no state between arcs).
+  auto trace_arcs = [&](int begin, int end) {
+    Tracer tracer(mesh, g, p, uv, node_at, opt);
+    for (int a = begin; a < end; ++a) {
+      const int h = 2 * a;
+      const int start_node = topo.half_node[h];
+      const int end_node = topo.half_node[h + 1];
+      ex.arcs[a] = tracer.trace(layout.nodes[start_node].vertex, labeling.chart_face[h],
+                                labeling.symbol[h], end_node, start_node);
+    }
+  };
+  if (opt.second_thread_arcs > 0 && topo.num_arcs >= opt.second_thread_arcs) {
+    const int half = topo.num_arcs / 2;
+    auto second = std::async(std::launch::async, trace_arcs, half, topo.num_arcs);
+    try {
+      trace_arcs(0, half);
+    } catch (...) {
+      second.wait();
+      throw;
+    }
+    second.get();
+  } else {
+    trace_arcs(0, topo.num_arcs);
+  }
+  for (int a = 0; a < topo.num_arcs; ++a)
     if (!ex.arcs[a].ok)
       ex.problems.push_back("arc " + std::to_string(layout.arcs[a].id) + ": " + ex.arcs[a].failure);
-  }
   // Crossings: segments of different arcs inside one face (in that face's chart). Segment i of
   // an arc (samples i, i + 1) lies in sample i + 1's face: both samples are on the boundary of
   // a common face, the one traversed. Segments by face (CSR, counting sort), and each

@@ -41,6 +41,9 @@ struct Extraction {
 struct TraceOptions {
   double vertex_snap = 1e-9;  //!< relative to the face's parametric size
   int max_steps_factor = 8;   //!< cap: factor · #F steps per arc
+  //! Layouts with at least this many arcs trace the second half of their arcs on a second
+  //! thread (the arcs are independent; same result). 0: always one thread.
+  int second_thread_arcs = 256;
 };
 
 //! Traces all arcs. \p corner_uv: (u, v) per face corner (Parameterization::corner_uv).
