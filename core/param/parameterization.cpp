@@ -442,9 +442,6 @@ const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCa
   auto t0 = std::chrono::steady_clock::now();
   const int n = system_.variables;
   const double aniso = options_.anisotropic ? options_.anisotropy : 1.0;
-  // Targets e^{s_t} u_t, e^{s_t} v_t (sizing): only the right-hand side and the constant change.
-  // The orientation constraints (solve_oriented) use the field's directions only, which the
-  // scale does not change; their QP gets the sized b.
   // A's pattern is fixed (ReducedAssembly): a new one is analyzed while the values are filled.
   if (options_.second_thread) {
     hint_ordering(assembly_.A());
@@ -455,6 +452,9 @@ const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCa
     const SpdSolver& solver;
     ~WaitForAnalysis() { solver.wait_for_analysis(); }
   } wait_for_analysis{solver_};
+  // Targets e^{s_t} u_t, e^{s_t} v_t (sizing): only the right-hand side and the constant change.
+  // The orientation constraints (solve_oriented) use the field's directions only, which the
+  // scale does not change; their QP gets the sized b.
   const std::vector<double> scale = target_scales(mesh, g, theta);
   assembly_.clear();
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
