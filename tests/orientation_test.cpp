@@ -455,5 +455,38 @@ TEST(OrientationRealData, InfeasibleConstraintsOnMaskKeepTheSolveAndSayWhy) {
   }
 }
 
+// OrientationOptions::stop_if_all_faces_infeasible on the mask (whose constraints are infeasible
+// on every face): small sets around the folded faces first (rings 0), then every face; that
+// round is infeasible, and the solve stops there with the best earlier round instead of growing
+// the set further (the node optimizer's setting where it has an earlier state to fall back to).
+TEST(OrientationRealData, StopsWhenEveryFaceIsInfeasible) {
+  const std::string dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
+  const TriMesh mesh = load_mesh(dir + "/mask_confmap.obj");
+  const test::MaskStar star = test::mask_star(mesh);
+  const Layout layout = test::dangling_star_layout(mesh, star.center, star.targets);
+  PipelineOptions options;
+  options.field.constraints.curvature = false;
+  options.param.orientation.enabled = true;
+  options.param.orientation.rings = 0;
+  options.param.orientation.all_faces_after_rounds = 1;
+  OrientationReport report[2];
+  for (int stop = 0; stop < 2; ++stop) {
+    options.param.orientation.stop_if_all_faces_infeasible = stop != 0;
+    Pipeline p(mesh, layout, options);
+    report[stop] = p.compute_parameterization().orientation;
+    std::printf("[stat] mask, rings 0, stop %d: rounds %d, all faces %d, %d -> %d fold-overs, %s\n",
+                stop, report[stop].rounds, report[stop].all_faces ? 1 : 0,
+                report[stop].foldovers_before, report[stop].foldovers_after,
+                report[stop].message.c_str());
+  }
+  ASSERT_TRUE(report[1].ran);
+  EXPECT_TRUE(report[1].all_faces);
+  EXPECT_NE(report[1].message.find("infeasible on every face"), std::string::npos)
+      << report[1].message;
+  EXPECT_LT(report[1].rounds, report[0].rounds);
+  EXPECT_LE(report[1].foldovers_after, report[1].foldovers_before);
+}
+
 }  // namespace
 }  // namespace qs

@@ -520,6 +520,15 @@ Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& g,
     }
     rep.iterations += ipm.iterations;
     if (ipm.infeasible && all_faces) {
+      if (o.stop_if_all_faces_infeasible) {
+        rep.message = "orientation constraints are infeasible on every face (round " +
+                      std::to_string(round + 1) + "); kept the best earlier solution (" +
+                      std::to_string(best_folds) + " fold-overs)";
+        rep.all_faces = true;
+        rep.foldovers_after = best_folds;
+        rep.time_s = seconds_since(t0);
+        return best_y.size() > 0 ? best_y : y0;
+      }
       // Too strict everywhere: back to the set of the rounds (grown by the faces the last
       // round folded), rounds only from here on.
       all_faces = false;
