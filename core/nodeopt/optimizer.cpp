@@ -100,6 +100,15 @@ std::vector<std::array<double, 3>> node_positions(const TriMesh& mesh, const Lay
 
 }  // namespace
 
+// Completes \p r with the node positions of (mesh, layout), appends it to \p reports and
+// streams it to the observer.
+void emit_step(StepReport r, const TriMesh& mesh, const Layout& layout,
+               std::vector<StepReport>& reports, Observer* observer) {
+  r.node_positions = node_positions(mesh, layout);
+  reports.push_back(std::move(r));
+  if (observer) observer->on_step(reports.back());
+}
+
 std::vector<int> movable_nodes(const TriMesh& mesh, const Layout& layout) {
   std::vector<char> feature(mesh.n_vertices(), 0);
   for (const auto& [a, b] : layout.feature_edges) feature[a] = feature[b] = 1;
@@ -169,9 +178,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     r.foldovers = current.foldovers;
     r.time_s = seconds_since(t_start);
     r.phase = "initial";
-    r.node_positions = node_positions(state.mesh, state.layout);
-    result.reports.push_back(r);
-    if (observer) observer->on_step(r);
+    emit_step(r, state.mesh, state.layout, result.reports, observer);
   }
 
   double alpha = no.alpha;
@@ -355,9 +362,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     r.moved_nodes = kept ? h.moved : 0;
     r.time_s = seconds_since(t_hop);
     r.phase = "hop";
-    r.node_positions = node_positions(state.mesh, state.layout);
-    result.reports.push_back(r);
-    if (observer) observer->on_step(r);
+    emit_step(r, state.mesh, state.layout, result.reports, observer);
     return kept;
   };
   // When a descent phase ends: a hop sweep; true when nodes hopped and a new phase begins.
@@ -481,9 +486,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
       r.accepted = false;
       r.foldovers = current.foldovers;
       r.time_s = seconds_since(t_step);
-      r.node_positions = node_positions(state.mesh, state.layout);
-      result.reports.push_back(r);
-      if (observer) observer->on_step(r);
+      emit_step(r, state.mesh, state.layout, result.reports, observer);
       if (polish()) continue;
       break;
     }
@@ -583,9 +586,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
       std::fill(rejected_target.begin(), rejected_target.end(), -1);
     }
     r.time_s = seconds_since(t_step);
-    r.node_positions = node_positions(state.mesh, state.layout);
-    result.reports.push_back(r);
-    if (observer) observer->on_step(r);
+    emit_step(r, state.mesh, state.layout, result.reports, observer);
   }
   if (!current_solved) {  // the last trial re-solved the Pipeline in place and was rejected
     check_cancel(observer);
@@ -616,9 +617,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     r.foldovers = out.foldovers_final;
     r.time_s = seconds_since(t_st);
     r.phase = "stiffening";
-    r.node_positions = node_positions(st.mesh, st.layout);
-    out.reports.push_back(r);
-    if (observer) observer->on_step(r);
+    emit_step(r, st.mesh, st.layout, out.reports, observer);
   };
   // Earlier states the fold-over removal falls back to (try_earlier below). With one, stiffening
   // waits until every state's orientation solve was tried: it is the costlier fallback and
@@ -671,9 +670,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
       r.foldovers = out.foldovers_final;
       r.time_s = seconds_since(t_or);
       r.phase = "orientation";
-      r.node_positions = node_positions(st_in.mesh, st_in.layout);
-      out.reports.push_back(r);
-      if (observer) observer->on_step(r);
+      emit_step(r, st_in.mesh, st_in.layout, out.reports, observer);
     }
     if (no.stiffen_at_end && out.foldovers_final > 0 && !has_earlier)
       stiffen_into(st_in, ev.pipeline, out);
