@@ -3,6 +3,7 @@
 #include <cmath>
 #include <future>
 #include <limits>
+#include <utility>
 #include <vector>
 
 namespace qs {
@@ -228,45 +229,8 @@ class Tracer {
   // three arcs of a valence-5 node started one sector off and ran into their neighbours'
   // nodes, although the parameterization had no fold-over.)
   std::vector<Start> start_sectors(int w, int face, const V2& dir) const {
-    const HH o0 = outgoing_in_face(w, face);
-    const int degree = vertex_degree(w);
-    const double inf = std::numeric_limits<double>::infinity();
-    // ccw from the first edge, `face` included.
-    double ccw_angle = inf, swept = wedge_angle(face, w);
-    Start ccw{-1, dir};
-    if (in_wedge(face, w, dir)) {
-      ccw_angle = angle_from_first_edge(face, w, dir);
-      ccw.face = face;
-    } else {
-      HH cur = o0;
-      V2 d = dir;
-      for (int s = 0; s < degree && (cur = step_ccw(cur, w, d)).is_valid(); ++s) {
-        const int f = mesh_.face_handle(cur).idx();
-        if (in_wedge(f, w, d)) {
-          ccw_angle = swept + angle_from_first_edge(f, w, d);
-          ccw = {f, d};
-          break;
-        }
-        swept += wedge_angle(f, w);
-      }
-    }
-    // cw across the first edge.
-    double cw_angle = inf;
-    Start cw{-1, dir};
-    {
-      HH cur = o0;
-      V2 d = dir;
-      swept = 0;
-      for (int s = 0; s < degree && (cur = step_cw(cur, w, d)).is_valid(); ++s) {
-        const int f = mesh_.face_handle(cur).idx();
-        if (in_wedge(f, w, d)) {
-          cw_angle = swept + (wedge_angle(f, w) - angle_from_first_edge(f, w, d));
-          cw = {f, d};
-          break;
-        }
-        swept += wedge_angle(f, w);
-      }
-    }
+    const auto [ccw, ccw_angle] = first_occurrence(w, face, dir, true);
+    const auto [cw, cw_angle] = first_occurrence(w, face, dir, false);
     std::vector<Start> out;
     if (ccw.face >= 0) out.push_back(ccw);
     // (Both ways can end in one face with two different directions: keep both.)
@@ -274,6 +238,27 @@ class Tracer {
       out.push_back(cw);
     if (out.size() == 2 && cw_angle < ccw_angle) std::swap(out[0], out[1]);
     return out;
+  }
+
+  // The first face around w whose wedge holds `dir` (carried through the transitions): ccw from
+  // the first edge with `face` included, or cw across the first edge; with the parametric angle
+  // swept from the first edge to that occurrence (infinity and face −1 when there is none).
+  std::pair<Start, double> first_occurrence(int w, int face, const V2& dir, bool ccw) const {
+    if (ccw && in_wedge(face, w, dir)) return {{face, dir}, angle_from_first_edge(face, w, dir)};
+    HH cur = outgoing_in_face(w, face);
+    V2 d = dir;
+    double swept = ccw ? wedge_angle(face, w) : 0;
+    const int degree = vertex_degree(w);
+    for (int s = 0; s < degree && (cur = ccw ? step_ccw(cur, w, d) : step_cw(cur, w, d)).is_valid();
+         ++s) {
+      const int f = mesh_.face_handle(cur).idx();
+      if (in_wedge(f, w, d)) {
+        const double a = angle_from_first_edge(f, w, d);
+        return {{f, d}, swept + (ccw ? a : wedge_angle(f, w) - a)};
+      }
+      swept += wedge_angle(f, w);
+    }
+    return {{-1, dir}, std::numeric_limits<double>::infinity()};
   }
 
   // The outgoing halfedge of vertex w in face f, and w's number of outgoing halfedges.

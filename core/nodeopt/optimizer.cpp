@@ -98,8 +98,6 @@ std::vector<std::array<double, 3>> node_positions(const TriMesh& mesh, const Lay
   return out;
 }
 
-}  // namespace
-
 // Completes \p r with the node positions of (mesh, layout), appends it to \p reports and
 // streams it to the observer.
 void emit_step(StepReport r, const TriMesh& mesh, const Layout& layout,
@@ -108,6 +106,8 @@ void emit_step(StepReport r, const TriMesh& mesh, const Layout& layout,
   reports.push_back(std::move(r));
   if (observer) observer->on_step(reports.back());
 }
+
+}  // namespace
 
 std::vector<int> movable_nodes(const TriMesh& mesh, const Layout& layout) {
   std::vector<char> feature(mesh.n_vertices(), 0);
