@@ -994,5 +994,36 @@ TEST(NodeOptimizer, ParallelRetryGivesTheSequentialTrajectory) {
     EXPECT_EQ(a.layout.nodes[n].vertex, b.layout.nodes[n].vertex);
 }
 
+// parallel_hops solves a node's hop candidates two at a time: the same sweeps, the same kept
+// hops and the same trajectory as one at a time, step for step (the example's polish keeps
+// hops, so the sweeps change the state).
+TEST(NodeOptimizer, ParallelHopsGiveTheSequentialTrajectory) {
+  NodeOptOptions sequential;
+  sequential.parallel_hops = false;
+  NodeOptStats s_seq, s_par;
+  const NodeOptResult a = optimize_example(sequential, &s_seq);
+  const NodeOptResult b = optimize_example(NodeOptOptions{}, &s_par);
+  EXPECT_EQ(s_seq.parallel_hop_jobs, 0);
+  if (std::thread::hardware_concurrency() >= 2) {
+    EXPECT_GT(s_par.parallel_hop_jobs, 0);
+  }
+  EXPECT_GT(a.hops, 0);
+  EXPECT_EQ(a.hops, b.hops);
+  EXPECT_EQ(a.hop_rounds, b.hop_rounds);
+  ASSERT_EQ(a.reports.size(), b.reports.size());
+  for (size_t k = 0; k < a.reports.size(); ++k) {
+    EXPECT_EQ(a.reports[k].phase, b.reports[k].phase) << "step " << k;
+    EXPECT_EQ(a.reports[k].accepted, b.reports[k].accepted) << "step " << k;
+    EXPECT_EQ(a.reports[k].moved_nodes, b.reports[k].moved_nodes) << "step " << k;
+    EXPECT_NEAR(a.reports[k].E, b.reports[k].E, 1e-12 * a.reports[k].E) << "step " << k;
+  }
+  EXPECT_NEAR(a.E_final, b.E_final, 1e-12 * a.E_final);
+  ASSERT_EQ(a.layout.nodes.size(), b.layout.nodes.size());
+  for (size_t n = 0; n < a.layout.nodes.size(); ++n)
+    EXPECT_EQ(a.layout.nodes[n].vertex, b.layout.nodes[n].vertex);
+  for (size_t i = 0; i < a.layout.arcs.size(); ++i)
+    EXPECT_EQ(a.layout.arcs[i].path, b.layout.arcs[i].path) << "arc " << i;
+}
+
 }  // namespace
 }  // namespace qs

@@ -6,6 +6,7 @@
 
 #include "app/cli/commands.h"
 #include "app/cli/signals.h"
+#include "core/base/allocator.h"
 #include "core/base/errors.h"
 #include "core/base/solver_threads.h"
 
@@ -13,6 +14,7 @@ int main(int argc, char** argv) {
   // First of all, so that a signal during start-up is never handled by the default action.
   qs::cli::install_signal_handlers();  // SIGINT/SIGTERM: cancel, report.json "cancelled", 130/143
   qs::limit_solver_threads_here();     // CHOLMOD's OpenMP regions: at most the idle cores
+  qs::keep_freed_memory();             // solves reuse freed memory (core/base/allocator.h)
   using namespace qs::cli;
   CLI::App app{"QuadSketch: quad layout embedding via aligned parameterization (headless)",
                "quadsketch-cli"};

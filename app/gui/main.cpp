@@ -2,8 +2,10 @@
 #include <CLI/CLI.hpp>
 
 #include "app/gui/app.h"
+#include "core/base/allocator.h"
 
 int main(int argc, char** argv) {
+  qs::keep_freed_memory();  // the worker's solves reuse freed memory (core/base/allocator.h)
   qs::app::AppOptions options;
   CLI::App cli("QuadSketch: sketch a quad layout on a triangle mesh and optimize it.");
   cli.add_option("--mesh", options.mesh_path, "Triangle mesh (.obj .off .ply .stl)");

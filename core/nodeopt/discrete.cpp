@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 
 #include "core/base/timing.h"
 #include "core/nodeopt/gradient.h"
@@ -100,67 +101,102 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
                          const std::vector<int>& nodes, const std::vector<Vec3>& directions,
                          double E, int foldovers, const HopSweepOptions& o,
                          const HopEvaluator& evaluate, Observer* observer,
-                         const RerouteContext* context) {
+                         const RerouteContext* context, const HopJobMaker* jobs) {
   HopSweepResult result;
   result.E = E;
   result.foldovers = foldovers;
+  const bool parallel = o.parallel && jobs && *jobs;
   int failures = 0;  // candidate solves since the last lower E
+  struct Candidate {
+    Layout layout;         // node n on vertex (routing of the trial)
+    int vertex = -1;       // the vertex w
+    bool restore = false;  // n stays on v with v at its original position
+    bool solved = false, ok = false;
+    double E = 0;
+    int foldovers = 0;
+  };
   for (size_t i = 0; i < nodes.size(); ++i) {
     const int n = nodes[i];
     const Vec3* direction = directions.empty() ? nullptr : &directions[i];
     if (direction && direction->norm() <= 0) direction = nullptr;
     const int v = layout.nodes[n].vertex;
     const Vec3 restored = original.point(original.vertex_handle(v));
-    Layout best_layout;
-    int best_vertex = -1;
-    double best_E = result.E;
-    int best_foldovers = result.foldovers;
-    // One solve: node n on vertex w (\p trial's routing) with v at its original position; a
-    // failed solve counts as one without a lower E.
-    auto try_vertex = [&](Layout trial, int w) {
-      check_cancel(observer);
-      TriMesh moved = mesh;
-      moved.set_point(moved.vertex_handle(v), restored);
-      ++result.evaluations;
-      double trial_E = 0;
-      int trial_foldovers = 0;
-      if (evaluate(moved, trial, trial_E, trial_foldovers) && trial_E < best_E) {
-        best_E = trial_E;
-        best_foldovers = trial_foldovers;
-        best_layout = std::move(trial);
-        best_vertex = w;
-        failures = 0;
-      } else {
-        ++failures;
-      }
-    };
-    if (o.try_restore && mesh.point(mesh.vertex_handle(v)) != restored &&
-        result.evaluations < o.max_evaluations &&
-        relocation_keeps_orientation(mesh, original, -1, v, restored, o.relocation))
-      try_vertex(layout, v);
-    std::vector<int> candidates;
+    // The node's candidates in the order they are tried, at most the evaluations left. The
+    // moved mesh is the same for all of them: v back at its original position.
+    std::vector<Candidate> list;
+    const int budget = o.max_evaluations - result.evaluations;
+    if (o.try_restore && mesh.point(mesh.vertex_handle(v)) != restored && budget > 0 &&
+        relocation_keeps_orientation(mesh, original, -1, v, restored, o.relocation)) {
+      Candidate c;
+      c.layout = layout;
+      c.vertex = v;
+      c.restore = true;
+      list.push_back(std::move(c));
+    }
+    std::vector<int> vertices;
     if (!o.targets.empty()) {
       const std::vector<char> forbidden = forbidden_relocation_vertices(original, layout, n);
       for (int w : o.targets[i]) {
-        if (w != v && !forbidden[w]) candidates.push_back(w);
+        if (w != v && !forbidden[w]) vertices.push_back(w);
       }
     } else if (o.try_neighbours) {
-      candidates = hop_candidates(original, layout, n, direction, o);
+      vertices = hop_candidates(original, layout, n, direction, o);
     }
-    for (int w : candidates) {
-      if (result.evaluations >= o.max_evaluations) break;
+    for (int w : vertices) {
+      if (static_cast<int>(list.size()) >= budget) break;
       const Vec3 at = mesh.point(mesh.vertex_handle(w));
       if (!relocation_keeps_orientation(mesh, original, v, w, at, o.relocation)) continue;
-      Layout trial = layout;
-      if (!move_node_and_reroute(mesh, trial, n, w, o.relocation, context)) continue;
-      try_vertex(std::move(trial), w);
-      if (o.max_failures > 0 && failures >= o.max_failures) break;
+      Candidate c;
+      c.layout = layout;
+      if (!move_node_and_reroute(mesh, c.layout, n, w, o.relocation, context)) continue;
+      c.vertex = w;
+      list.push_back(std::move(c));
     }
-    if (best_vertex >= 0) {
-      layout = std::move(best_layout);
+    if (list.empty()) {
+      if (result.evaluations >= o.max_evaluations) break;
+      if (o.max_failures > 0 && failures >= o.max_failures) break;
+      continue;
+    }
+    TriMesh moved = mesh;
+    moved.set_point(moved.vertex_handle(v), restored);
+    // Solves candidate k (and k + 1 on a second thread, in parallel mode).
+    auto solve = [&](size_t k) {
+      check_cancel(observer);
+      if (parallel && k + 1 < list.size()) {
+        const HopJob first = (*jobs)(moved, list[k].layout);
+        const HopJob second = (*jobs)(moved, list[k + 1].layout);
+        Candidate& b = list[k + 1];
+        auto other =
+            std::async(std::launch::async, [&second, &b]() { b.ok = second(b.E, b.foldovers); });
+        Candidate& a = list[k];
+        a.ok = first(a.E, a.foldovers);  // on throw, the future's destructor waits for b
+        other.get();
+        a.solved = b.solved = true;
+        return;
+      }
+      Candidate& a = list[k];
+      a.ok = evaluate(moved, a.layout, a.E, a.foldovers);
+      a.solved = true;
+    };
+    int best = -1;
+    double best_E = result.E;
+    for (size_t k = 0; k < list.size(); ++k) {
+      if (!list[k].solved) solve(k);
+      ++result.evaluations;
+      if (list[k].ok && list[k].E < best_E) {
+        best_E = list[k].E;
+        best = static_cast<int>(k);
+        failures = 0;
+      } else {
+        ++failures;  // a failed solve counts as one without a lower E
+      }
+      if (!list[k].restore && o.max_failures > 0 && failures >= o.max_failures) break;
+    }
+    if (best >= 0) {
+      layout = std::move(list[best].layout);
       mesh.set_point(mesh.vertex_handle(v), restored);
       result.E = best_E;
-      result.foldovers = best_foldovers;
+      result.foldovers = list[best].foldovers;
       ++result.moved;
     }
     if (result.evaluations >= o.max_evaluations) break;

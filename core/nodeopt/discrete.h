@@ -36,6 +36,13 @@ NodeOptResult relocate_nodes_discrete(const TriMesh& mesh, const Layout& layout,
 using HopEvaluator =
     std::function<bool(const TriMesh& mesh, const Layout& layout, double& E, int& foldovers)>;
 
+//! One candidate's solve, prepared on the sweep's thread and run on any thread: it shares no
+//! mutable state with the caller or with other jobs (its Pipeline owns its factorizations).
+//! Returns false for a failed solve (E and foldovers then unset).
+using HopJob = std::function<bool(double& E, int& foldovers)>;
+//! Prepares the job of one candidate (mesh, layout); called on the sweep's thread only.
+using HopJobMaker = std::function<HopJob(const TriMesh& mesh, const Layout& layout)>;
+
 struct HopSweepOptions {
   //! Per node, at most this many neighbouring vertices are tried (≤ 0: all free neighbours).
   //! With a preferred direction the ones best aligned with it come first.
@@ -58,6 +65,11 @@ struct HopSweepOptions {
   //! The sweep stops after this many candidate solves in a row that found no lower E
   //! (≤ 0: no limit); with the most promising nodes first, the rest rarely pays.
   int max_failures = 0;
+  //! With a HopJobMaker (hop_sweep's \p jobs): a node's candidates are solved two at a time,
+  //! one on a second thread. The candidates and the kept move are those of the one-at-a-time
+  //! order: the results are read in that order, and a solve past the point where the sequential
+  //! sweep would have stopped (max_failures) is discarded, not counted.
+  bool parallel = false;
 };
 
 struct HopSweepResult {
@@ -109,6 +121,7 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
                          const std::vector<int>& nodes, const std::vector<Vec3>& directions,
                          double E, int foldovers, const HopSweepOptions& options,
                          const HopEvaluator& evaluate, Observer* observer = nullptr,
-                         const RerouteContext* context = nullptr);
+                         const RerouteContext* context = nullptr,
+                         const HopJobMaker* jobs = nullptr);
 
 }  // namespace qs

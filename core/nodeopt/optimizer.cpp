@@ -229,6 +229,45 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
         return false;
       }
     };
+    // Two at a time (parallel_hops): each job's Pipeline is built here and owns its
+    // factorizations before any thread solves it.
+    const HopJobMaker make_job = [&](const TriMesh& m, const Layout& l) -> HopJob {
+      ++counters.parallel_hop_jobs;
+      if (no.reuse_field && current.pipeline->field()) {
+        std::shared_ptr<Pipeline> p;
+        try {
+          p = std::make_shared<Pipeline>(m, l, *current.pipeline);
+          p->unshare_solvers();
+        } catch (const QsError&) {
+          return [](double&, int&) { return false; };
+        }
+        ++counters.relayouts;
+        return [p, &options](double& E, int& folds) {
+          try {
+            Evaluation ev;
+            ev.pipeline = p;
+            solve_and_measure(ev, options);
+            E = ev.E;
+            folds = ev.foldovers;
+            return true;
+          } catch (const QsError&) {
+            return false;
+          }
+        };
+      }
+      ++counters.fresh_pipelines;
+      return [m, l, &options](double& E, int& folds) {
+        try {
+          const Evaluation ev = evaluate_fresh(m, l, options, false);
+          E = ev.E;
+          folds = ev.foldovers;
+          return true;
+        } catch (const QsError&) {
+          return false;
+        }
+      };
+    };
+    const bool parallel_hops = no.parallel_hops && std::thread::hardware_concurrency() >= 2;
     State hopped = state;
     HopSweepResult h;
     h.E = current.E;
@@ -238,9 +277,11 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     auto run_sweep = [&](const std::vector<int>& nodes, const std::vector<Vec3>& directions,
                          HopSweepOptions sweep, bool counts_evaluations) {
       sweep.relocation = no.relocation;
+      sweep.parallel = parallel_hops;
       if (nodes.empty() || sweep.max_evaluations <= 0) return;
-      const HopSweepResult s = hop_sweep(original, hopped.mesh, hopped.layout, nodes, directions,
-                                         h.E, h.foldovers, sweep, evaluate, observer, &reroute);
+      const HopSweepResult s =
+          hop_sweep(original, hopped.mesh, hopped.layout, nodes, directions, h.E, h.foldovers,
+                    sweep, evaluate, observer, &reroute, &make_job);
       h.moved += s.moved;
       if (counts_evaluations) h.evaluations += s.evaluations;
       h.E = s.E;

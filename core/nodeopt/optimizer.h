@@ -96,6 +96,11 @@ struct NodeOptOptions {
   //! The neighbour hops stop after this many solves in a row without a lower E (≤ 0: no
   //! limit): on large models most of the budget would otherwise be spent without gain.
   int hop_max_failures = 16;
+  //! A node's hop candidates are solved two at a time, one on a second thread
+  //! (HopSweepOptions::parallel), when the machine reports two hardware threads. Each candidate's
+  //! continued Pipeline copies its field factorizations (Pipeline::unshare_solvers) before it
+  //! is solved. Same candidates, same kept moves, same result as one at a time.
+  bool parallel_hops = true;
   //! Each sweep first tries, as one solve, all relocations undone at once together with the
   //! cone hops below (a node on the right vertex only helps when its neighbours are too).
   bool hop_collective = true;
@@ -168,13 +173,14 @@ struct NodeOptResult {
 
 //! Counters of the work done by optimize_nodes (for benchmarks and the reuse test).
 struct NodeOptStats {
-  int fresh_pipelines = 0;   //!< Pipelines built from scratch (the start, reuse_field off)
-  int relayouts = 0;         //!< Pipelines continued from the current one (a node switched)
-  int reused_solves = 0;     //!< re-solves of the previous Pipeline after vertices moved
-  int gradient_reuses = 0;   //!< steps after a rejection that reused the gradient
-  int tabu_steps = 0;        //!< trials rejected as repeated switches (switch_tabu)
-  int parallel_retries = 0;  //!< re-layouts solved beside their retry (parallel_retry)
-  bool warm_start = false;   //!< the given start Pipeline served as the initial solve
+  int fresh_pipelines = 0;    //!< Pipelines built from scratch (the start, reuse_field off)
+  int relayouts = 0;          //!< Pipelines continued from the current one (a node switched)
+  int reused_solves = 0;      //!< re-solves of the previous Pipeline after vertices moved
+  int gradient_reuses = 0;    //!< steps after a rejection that reused the gradient
+  int tabu_steps = 0;         //!< trials rejected as repeated switches (switch_tabu)
+  int parallel_retries = 0;   //!< re-layouts solved beside their retry (parallel_retry)
+  int parallel_hop_jobs = 0;  //!< hop candidates prepared for a two-at-a-time solve
+  bool warm_start = false;    //!< the given start Pipeline served as the initial solve
 };
 
 //! Nodes that the optimizer may move: not pinned, not an end of a pinned arc, not on the mesh
