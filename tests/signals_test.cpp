@@ -16,6 +16,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "core/layout/layout_io.h"
@@ -34,7 +35,7 @@ struct BigInput {
   int faces = 0;
 };
 
-// cube_sphere(k) has 12 k² triangles: k = 60 gives 43 200 (a run of a few seconds).
+// cube_sphere(k) has 12 k² triangles: k = 60 gives 43 200 (`--no-node-opt`: 0.3 s in session 8).
 const BigInput& big_input() {
   static const BigInput input = [] {
     BigInput in;
@@ -131,12 +132,20 @@ struct RunOutcome {
   double seconds = 0;
 };
 
-RunOutcome run_and_signal(const std::string& out, int signo, std::chrono::milliseconds delay) {
+// \p node_opt: the whole pipeline (5 node optimization steps, seconds) instead of
+// --no-node-opt (0.3 s on an idle machine in session 8).
+RunOutcome run_and_signal(const std::string& out, int signo, std::chrono::milliseconds delay,
+                          bool node_opt = false) {
   const BigInput& in = big_input();
   const auto t0 = std::chrono::steady_clock::now();
-  const pid_t pid = spawn_cli({"optimize", "--no-node-opt", "--quiet", "--mesh", in.mesh,
-                               "--layout", in.layout, "--out", out},
-                              out + ".log");
+  std::vector<std::string> args = {"optimize", "--quiet", "--mesh", in.mesh,
+                                   "--layout", in.layout, "--out",  out};
+  if (node_opt) {
+    args.insert(args.end(), {"--steps", "5"});
+  } else {
+    args.push_back("--no-node-opt");
+  }
+  const pid_t pid = spawn_cli(args, out + ".log");
   EXPECT_GT(pid, 0);
   RunOutcome r;
   if (pid <= 0) return r;
@@ -166,10 +175,14 @@ void expect_cancelled_or_ok(const RunOutcome& r, int signo, const std::string& l
 TEST(Signals, SigtermAtVariousMomentsLeavesOnlyCompleteFiles) {
   const std::string base = test::temp_dir("signals_term");
   int cancelled = 0;
-  for (int delay_ms : {100, 400, 1000, 2500}) {
-    SCOPED_TRACE("delay " + std::to_string(delay_ms) + " ms");
+  // --no-node-opt runs (about as long as the first delays: start, solve or writing) and whole
+  // pipelines (signalled during the node optimization).
+  const std::pair<int, bool> moments[] = {{100, false}, {250, false}, {1000, true}, {2500, true}};
+  for (const auto& [delay_ms, node_opt] : moments) {
+    SCOPED_TRACE("delay " + std::to_string(delay_ms) + " ms" + (node_opt ? ", node opt" : ""));
     const std::string out = base + "/run" + std::to_string(delay_ms);
-    const RunOutcome r = run_and_signal(out, SIGTERM, std::chrono::milliseconds(delay_ms));
+    const RunOutcome r =
+        run_and_signal(out, SIGTERM, std::chrono::milliseconds(delay_ms), node_opt);
     expect_cancelled_or_ok(r, SIGTERM, out + ".log");
     cancelled += (r.status == "cancelled");
     std::cerr << "SIGTERM after " << delay_ms << " ms: exit " << r.exit_code << ", status "
@@ -180,7 +193,8 @@ TEST(Signals, SigtermAtVariousMomentsLeavesOnlyCompleteFiles) {
 
 TEST(Signals, SigintGivesExitCode130) {
   const std::string out = test::temp_dir("signals_int") + "/out";
-  const RunOutcome r = run_and_signal(out, SIGINT, 300ms);
+  // The whole pipeline: --no-node-opt on this input can end before the signal.
+  const RunOutcome r = run_and_signal(out, SIGINT, 300ms, true);
   expect_cancelled_or_ok(r, SIGINT, out + ".log");
   EXPECT_EQ(r.status, "cancelled");
 }

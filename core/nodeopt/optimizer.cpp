@@ -1,8 +1,10 @@
 #include "core/nodeopt/optimizer.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <future>
 #include <memory>
 #include <thread>
@@ -669,7 +671,10 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
   // The end of the descent at (state, current): fold-over removal, results into `out`.
   // \p fallback: an earlier state will be tried when fold-overs remain here, so an infeasible
   // all-faces orientation round ends this attempt.
-  auto finish = [&](const State& st_in, const Evaluation& ev, NodeOptResult& out, bool fallback) {
+  // \p obs: polled and streamed to (the observer, or nullptr for a speculative attempt whose
+  // reports are streamed later, see try_earlier).
+  auto finish = [&](const State& st_in, const Evaluation& ev, NodeOptResult& out, bool fallback,
+                    Observer* obs) {
     out.pipeline = ev.pipeline;
     out.descent_pipeline = ev.pipeline;
     out.E_descent = ev.E;
@@ -681,7 +686,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     // stiffening (§7.1) only as the fallback when fold-overs remain.
     if (no.orientation_at_end && ev.foldovers > 0) {
       const auto t_or = std::chrono::steady_clock::now();
-      check_cancel(observer);
+      check_cancel(obs);
       PipelineOptions oriented = options;
       oriented.param.orientation = no.orientation;
       oriented.param.orientation.enabled = true;
@@ -711,12 +716,49 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
       r.foldovers = out.foldovers_final;
       r.time_s = seconds_since(t_or);
       r.phase = "orientation";
-      emit_step(r, st_in.mesh, st_in.layout, out.reports, observer);
+      emit_step(r, st_in.mesh, st_in.layout, out.reports, obs);
     }
     if (no.stiffen_at_end && out.foldovers_final > 0 && !has_earlier)
       stiffen_into(st_in, ev.pipeline, out);
   };
-  finish(state, current, result, has_earlier);
+  // The fold-over removal at the state before the polish, solved speculatively
+  // (parallel_fallback). Declared after the lambda and the states it reads: its destructor
+  // waits for it before they go away. `stop` ends it at its next poll once it is not needed.
+  struct Speculative {
+    Evaluation evaluation;
+    NodeOptResult result;
+    std::exception_ptr error;
+  };
+  struct StopFlag : Observer {
+    std::atomic<bool> stop{false};
+    bool should_cancel() const override { return stop.load(); }
+  } speculative_stop;
+  std::future<Speculative> speculative;
+  struct StopOnExit {  // also on an exception: the future's destructor then waits less
+    StopFlag& flag;
+    ~StopOnExit() { flag.stop = true; }
+  } stop_on_exit{speculative_stop};
+  // parallel_fallback: the state before the polish is solved and oriented on a second thread
+  // while this one orients the final state; its result (and its reports) are used exactly when
+  // the sequential order would have tried it.
+  if (no.orientation_at_end && pre_polish && current.foldovers > 0 && no.parallel_fallback &&
+      std::thread::hardware_concurrency() >= 2) {
+    const State* earlier = pre_polish.get();
+    const bool later = try_fewest;
+    speculative = std::async(std::launch::async, [&, earlier, later]() {
+      Speculative out;
+      try {
+        out.evaluation = evaluate_fresh(earlier->mesh, earlier->layout, options, false);
+        check_cancel(&speculative_stop);
+        finish(*earlier, out.evaluation, out.result, later, &speculative_stop);
+      } catch (...) {
+        out.error = std::current_exception();
+      }
+      return out;
+    });
+  }
+  finish(state, current, result, has_earlier, observer);
+  if (result.foldovers_final == 0) speculative_stop.stop = true;  // not needed
   // The descent and the polish lower E but can end where the fold-over removal fails although
   // it succeeds at an earlier state: the state before the first hop, then the accepted state
   // with the fewest fold-overs, are tried; a result with fewer fold-overs (equal: lower final
@@ -725,10 +767,19 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
   auto try_earlier = [&](std::unique_ptr<State>& earlier, bool& flag, bool later) {
     if (result.foldovers_final == 0 || !earlier) return;
     check_cancel(observer);
-    Evaluation ev = evaluate_fresh(earlier->mesh, earlier->layout, options, false);
-    ++counters.fresh_pipelines;
     NodeOptResult alt;
-    finish(*earlier, ev, alt, later);
+    if (speculative.valid() && earlier == pre_polish) {
+      Speculative done = speculative.get();
+      if (done.error) std::rethrow_exception(done.error);
+      alt = std::move(done.result);
+      ++counters.parallel_fallbacks;
+      if (observer)  // streamed now, in the order of the sequential attempt
+        for (const StepReport& r : alt.reports) observer->on_step(r);
+    } else {
+      Evaluation ev = evaluate_fresh(earlier->mesh, earlier->layout, options, false);
+      finish(*earlier, ev, alt, later, observer);
+    }
+    ++counters.fresh_pipelines;
     result.reports.insert(result.reports.end(), alt.reports.begin(), alt.reports.end());
     if (alt.foldovers_final < result.foldovers_final ||
         (alt.foldovers_final == result.foldovers_final && alt.E_final < result.E_final)) {

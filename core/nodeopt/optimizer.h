@@ -101,6 +101,12 @@ struct NodeOptOptions {
   //! continued Pipeline copies its field factorizations (Pipeline::unshare_solvers) before it
   //! is solved. Same candidates, same kept moves, same result as one at a time.
   bool parallel_hops = true;
+  //! When fold-overs remain after the descent and the polish kept hops, the state before the
+  //! polish (the first fallback of the fold-over removal) is solved and oriented on a second
+  //! thread while the final state is oriented, on machines with two hardware threads. Its
+  //! result and reports are used exactly when the sequential order would have tried it (the
+  //! final state keeps fold-overs); otherwise it is stopped at its next poll and discarded.
+  bool parallel_fallback = true;
   //! Each sweep first tries, as one solve, all relocations undone at once together with the
   //! cone hops below (a node on the right vertex only helps when its neighbours are too).
   bool hop_collective = true;
@@ -173,14 +179,15 @@ struct NodeOptResult {
 
 //! Counters of the work done by optimize_nodes (for benchmarks and the reuse test).
 struct NodeOptStats {
-  int fresh_pipelines = 0;    //!< Pipelines built from scratch (the start, reuse_field off)
-  int relayouts = 0;          //!< Pipelines continued from the current one (a node switched)
-  int reused_solves = 0;      //!< re-solves of the previous Pipeline after vertices moved
-  int gradient_reuses = 0;    //!< steps after a rejection that reused the gradient
-  int tabu_steps = 0;         //!< trials rejected as repeated switches (switch_tabu)
-  int parallel_retries = 0;   //!< re-layouts solved beside their retry (parallel_retry)
-  int parallel_hop_jobs = 0;  //!< hop candidates prepared for a two-at-a-time solve
-  bool warm_start = false;    //!< the given start Pipeline served as the initial solve
+  int fresh_pipelines = 0;     //!< Pipelines built from scratch (the start, reuse_field off)
+  int relayouts = 0;           //!< Pipelines continued from the current one (a node switched)
+  int reused_solves = 0;       //!< re-solves of the previous Pipeline after vertices moved
+  int gradient_reuses = 0;     //!< steps after a rejection that reused the gradient
+  int tabu_steps = 0;          //!< trials rejected as repeated switches (switch_tabu)
+  int parallel_retries = 0;    //!< re-layouts solved beside their retry (parallel_retry)
+  int parallel_hop_jobs = 0;   //!< hop candidates prepared for a two-at-a-time solve
+  int parallel_fallbacks = 0;  //!< speculative fallback solves that were used (parallel_fallback)
+  bool warm_start = false;     //!< the given start Pipeline served as the initial solve
 };
 
 //! Nodes that the optimizer may move: not pinned, not an end of a pinned arc, not on the mesh
