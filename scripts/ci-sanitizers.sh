@@ -46,7 +46,7 @@ for step in "${steps[@]}"; do
       "$root/build-tsan/tests/param_test" --gtest_brief=1 \
         --gtest_filter='Parameterization.SecondThread*'
       "$root/build-tsan/tests/nodeopt_test" --gtest_brief=1 \
-        --gtest_filter='NodeOptimizer.Parallel*'
+        --gtest_filter='NodeOptimizer.Parallel*:DiscreteRelocation.Parallel*'
       ;;
     *)
       echo "ci-sanitizers: unknown step '$step' (asan or tsan)" >&2

@@ -653,6 +653,31 @@ TEST(DiscreteRelocation, LowersEnergy) {
   for (const auto& s : rec.steps) EXPECT_LE(s.E, r.E_init * (1 + 1e-12));
 }
 
+// Two candidates at a time (DiscreteOptions::parallel): the same sweeps and the same result.
+TEST(DiscreteRelocation, ParallelCandidatesGiveTheSequentialResult) {
+  const auto in = test::cube_sphere(6, Vec3(1.3, 1, 0.75));
+  const Layout start = test::displace_nodes(in.mesh, in.layout, 2, 5);
+  DiscreteOptions sequential;
+  sequential.max_steps = 3;
+  sequential.parallel = false;
+  DiscreteOptions parallel = sequential;
+  parallel.parallel = true;
+  Recorder rec_a, rec_b;
+  const NodeOptResult a =
+      relocate_nodes_discrete(in.mesh, start, PipelineOptions{}, sequential, &rec_a);
+  const NodeOptResult b =
+      relocate_nodes_discrete(in.mesh, start, PipelineOptions{}, parallel, &rec_b);
+  EXPECT_LT(a.E_final, a.E_init);
+  ASSERT_EQ(rec_a.steps.size(), rec_b.steps.size());
+  for (size_t k = 0; k < rec_a.steps.size(); ++k) {
+    EXPECT_EQ(rec_a.steps[k].moved_nodes, rec_b.steps[k].moved_nodes) << "step " << k;
+    EXPECT_NEAR(rec_a.steps[k].E, rec_b.steps[k].E, 1e-12 * rec_a.steps[k].E) << "step " << k;
+  }
+  ASSERT_EQ(a.layout.nodes.size(), b.layout.nodes.size());
+  for (size_t n = 0; n < a.layout.nodes.size(); ++n)
+    EXPECT_EQ(a.layout.nodes[n].vertex, b.layout.nodes[n].vertex);
+}
+
 // ---------------------------------------------------------------------------------------------
 // (f) reuse across steps (issue #5 speed): the shortcuts must not change results
 

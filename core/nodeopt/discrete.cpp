@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <future>
+#include <thread>
 
 #include "core/base/timing.h"
 #include "core/nodeopt/gradient.h"
@@ -108,8 +109,7 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
   const bool parallel = o.parallel && jobs && *jobs;
   int failures = 0;  // candidate solves since the last lower E
   struct Candidate {
-    Layout layout;         // node n on vertex (routing of the trial)
-    int vertex = -1;       // the vertex w
+    Layout layout;         // node n on its candidate vertex (the trial's routing)
     bool restore = false;  // n stays on v with v at its original position
     bool solved = false, ok = false;
     double E = 0;
@@ -129,7 +129,6 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
         relocation_keeps_orientation(mesh, original, -1, v, restored, o.relocation)) {
       Candidate c;
       c.layout = layout;
-      c.vertex = v;
       c.restore = true;
       list.push_back(std::move(c));
     }
@@ -149,7 +148,6 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
       Candidate c;
       c.layout = layout;
       if (!move_node_and_reroute(mesh, c.layout, n, w, o.relocation, context)) continue;
-      c.vertex = w;
       list.push_back(std::move(c));
     }
     if (list.empty()) {
@@ -239,14 +237,19 @@ NodeOptResult relocate_nodes_discrete(const TriMesh& mesh, const Layout& layout,
   result.E_init = E;
   result.foldovers_init = foldovers;
   const std::vector<int> movable = movable_nodes(mesh, layout);
+  // Every candidate gets a fresh Pipeline: a job only needs its own copies of the input.
+  const HopJobMaker make_job = [&](const TriMesh& m, const Layout& l) -> HopJob {
+    return [&, m, l](double& E, int& folds) { return evaluate(m, l, E, folds); };
+  };
   HopSweepOptions sweep;
   sweep.relocation = d.relocation;
+  sweep.parallel = d.parallel && std::thread::hardware_concurrency() >= 2;
   int evaluations = 0;
   for (int step = 1; step <= d.max_steps && evaluations < d.max_evaluations; ++step) {
     const auto t_step = std::chrono::steady_clock::now();
     sweep.max_evaluations = d.max_evaluations - evaluations;
     const HopSweepResult s = hop_sweep(mesh, result.mesh, result.layout, movable, {}, E, foldovers,
-                                       sweep, evaluate, observer);
+                                       sweep, evaluate, observer, nullptr, &make_job);
     evaluations += s.evaluations;
     E = s.E;
     foldovers = s.foldovers;

@@ -20,6 +20,9 @@ struct DiscreteOptions {
   int max_steps = 25;            //!< sweeps over all nodes
   int max_evaluations = 2000;    //!< total candidate solves (work cap)
   RelocationOptions relocation;  //!< re-routing of the moved node's arcs
+  //! A node's candidates are solved two at a time (HopSweepOptions::parallel) when the machine
+  //! reports two hardware threads; same result as one at a time.
+  bool parallel = true;
 };
 
 //! Runs the discrete baseline on the original mesh positions (no vertex relocation). Nodes move
@@ -114,9 +117,10 @@ ConeCandidates cone_candidates(const TriMesh& original, const TriMesh& mesh, con
 //! with the lowest E is kept at once when it is below the current E (\p E at the start).
 //! \p directions is empty (no preference) or has one preferred direction per entry of \p nodes
 //! (3D; a zero vector: no preference for that node). \p mesh and \p layout are updated in
-//! place.
+//! place. \p evaluate solves one candidate on this thread; with HopSweepOptions::parallel, \p jobs
+//! prepares pairs of candidates that are solved side by side (the last odd one by \p evaluate).
 //! \pre mesh and original have the same connectivity; layout is valid on them.
-//! \throw Cancelled (polled before every solve).
+//! \throw Cancelled (polled before every solve or pair of solves).
 HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
                          const std::vector<int>& nodes, const std::vector<Vec3>& directions,
                          double E, int foldovers, const HopSweepOptions& options,
