@@ -227,6 +227,11 @@ int main(int argc, char** argv) {
         const qs::PipelineOptions options;
         qs::NodeOptOptions no = hop;
         no.max_steps = max_steps;
+        // CPU time compares the methods: both solve one candidate at a time (the second threads
+        // of parallel_hops and DiscreteOptions::parallel shorten the wall time but add CPU, most
+        // on small meshes: the discrete ellipsoid run 1.4 s → 1.8 s).
+        no.parallel_hops = false;
+        no.parallel_fallback = false;
         if (hop_all) {
           no.hop_min_offset = 0;
           no.hop_candidates = 0;
@@ -261,6 +266,7 @@ int main(int argc, char** argv) {
         qs::DiscreteOptions d;
         d.max_steps = max_steps;
         d.max_evaluations = 1 << 30;  // no work cap: run to its own end
+        d.parallel = false;
         const double t0 = cpu_now();
         const qs::NodeOptResult rx = qs::relocate_nodes_discrete(c.mesh, start, options, d);
         const double t_disc = cpu_now() - t0;

@@ -136,7 +136,7 @@ double param_signed_area2(const std::vector<std::array<double, 2>>& uv, int f) {
 ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layout& layout,
                          const LayoutTopology& topo, const std::vector<int>& p,
                          const std::vector<double>& theta, const ParamOptions& options,
-                         ParamSolver* previous)
+                         ParamSolver* previous, bool solve_now)
     : options_(options), period_jump_(p) {
   const auto t0 = std::chrono::steady_clock::now();
   if (!options_.face_weights.empty() && static_cast<int>(options_.face_weights.size()) != g.n_faces)
@@ -382,7 +382,12 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
             options_.sizing.exclude_singular_faces)
       sizing_ = std::move(previous->sizing_);
   }
-  solve(mesh, g, theta);
+  if (solve_now) {
+    solve(mesh, g, theta);
+  } else if (options_.second_thread) {  // the first factorization's analysis, meanwhile
+    hint_ordering(assembly_.A());
+    solver_.begin_analysis(assembly_.A());
+  }
 }
 
 ParamSolver::~ParamSolver() = default;

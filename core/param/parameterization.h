@@ -92,12 +92,16 @@ class ParamSolver {
   //! swaps linear solvers with it, so CHOLMOD's symbolic analysis is reused when the reduced
   //! matrix has exactly the same sparsity pattern (unchanged combinatorics), and redone
   //! otherwise. \p previous stays usable (its next solve re-analyzes).
+  //! \p solve_now false: no solve yet (result() is empty until the first solve()); the symbolic
+  //! analysis starts (on the second thread, ParamOptions::second_thread) and the first
+  //! factorization is the next solve()'s or optimal_field_rotation()'s. For a field whose
+  //! rotation is still to be chosen, a first solve would be thrown away.
   //! \throw TopologyError, InvalidInputError (incompatible constraints naming arcs),
   //! SolverError.
   ParamSolver(const TriMesh& mesh, const GeometryCache& geometry, const Layout& layout,
               const LayoutTopology& topology, const std::vector<int>& period_jump,
               const std::vector<double>& theta, const ParamOptions& options = {},
-              ParamSolver* previous = nullptr);
+              ParamSolver* previous = nullptr, bool solve_now = true);
   ~ParamSolver();
 
   //! Assembles the energy for the current geometry and field and solves; reuses the symbolic

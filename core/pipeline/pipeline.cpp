@@ -89,15 +89,14 @@ const Parameterization& Pipeline::compute_parameterization() {
   const CrossField& field = field_current() ? field_solver_->field() : compute_field();
   extraction_.reset();
   if (!param_solver_) {
-    // With a free rotation the solve after it counts: no orientation constraints before.
-    ParamOptions first = options_.param;
-    if (field.gauge_face >= 0) first.orientation.enabled = false;
-    param_solver_ = std::make_unique<ParamSolver>(mesh_, geometry_, layout_, topology_,
-                                                  field.period_jump, field.theta, first);
-    if (field.gauge_face < 0) return param_solver_->result();
-    param_solver_->set_orientation(options_.param.orientation);
     // No direction constraints: the field's global rotation is free. Take the one that
-    // minimizes the energy, not an arbitrary anchor (that would depend on arc routing).
+    // minimizes the energy, not an arbitrary anchor (that would depend on arc routing); the
+    // solver's first solve waits until it is chosen.
+    const bool free_rotation = field.gauge_face >= 0;
+    param_solver_ =
+        std::make_unique<ParamSolver>(mesh_, geometry_, layout_, topology_, field.period_jump,
+                                      field.theta, options_.param, nullptr, !free_rotation);
+    if (!free_rotation) return param_solver_->result();
   }
   if (field.gauge_face >= 0)
     field_solver_->rotate(param_solver_->optimal_field_rotation(mesh_, geometry_, field.theta));
