@@ -201,6 +201,31 @@ TEST(Parameterization, SecondThreadGivesIdenticalResults) {
   }
 }
 
+// ParamSolver(…, solve_now = false): no result until the first solve, which then equals the
+// constructor's own solve; the analysis started in the constructor is the only one, and a
+// solver destroyed before any solve waits for it (run under TSan in CI).
+TEST(Parameterization, SecondThreadDeferredFirstSolve) {
+  const auto in = test::cube_sphere(8);
+  const Solved a = solve_all(in);
+  for (const bool second_thread : {false, true}) {
+    ParamOptions opt;
+    opt.second_thread = second_thread;
+    {
+      ParamSolver unused(in.mesh, a.geometry, in.layout, a.topology, a.field.period_jump,
+                         a.field.theta, opt, nullptr, false);
+    }
+    ParamSolver deferred(in.mesh, a.geometry, in.layout, a.topology, a.field.period_jump,
+                         a.field.theta, opt, nullptr, false);
+    EXPECT_TRUE(deferred.result().corner_uv.empty());
+    EXPECT_EQ(deferred.linear_solver().stats().factorizations, 0);
+    const Parameterization& r = deferred.solve(in.mesh, a.geometry, a.field.theta);
+    EXPECT_EQ(r.corner_uv, a.param->result().corner_uv) << "second thread " << second_thread;
+    EXPECT_EQ(r.energy, a.param->result().energy);
+    EXPECT_EQ(deferred.linear_solver().stats().analyses, 1);
+    EXPECT_EQ(deferred.linear_solver().stats().factorizations, 1);
+  }
+}
+
 // TraceOptions::second_thread_arcs: tracing half of the arcs on a second thread gives the same
 // extraction as one thread (every sample, the problems in arc order, the equivalence).
 TEST(Parameterization, SecondThreadTracesTheSameArcs) {
