@@ -235,6 +235,29 @@ void expect_monotone(const NodeOptResult& r, const Recorder& rec) {
   EXPECT_NEAR(r.E_descent, last, 1e-12 * last);
 }
 
+// Two runs that must be the same step for step (a threaded option against its sequential
+// order): phases, decisions, fold-overs and E of every step.
+void expect_same_steps(const std::vector<StepReport>& a, const std::vector<StepReport>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].phase, b[k].phase) << "step " << k;
+    EXPECT_EQ(a[k].accepted, b[k].accepted) << "step " << k;
+    EXPECT_EQ(a[k].moved_nodes, b[k].moved_nodes) << "step " << k;
+    EXPECT_EQ(a[k].foldovers, b[k].foldovers) << "step " << k;
+    EXPECT_NEAR(a[k].E, b[k].E, 1e-12 * a[k].E) << "step " << k;
+  }
+}
+
+// … and end with the same nodes and arc routes.
+void expect_same_layout(const Layout& a, const Layout& b) {
+  ASSERT_EQ(a.nodes.size(), b.nodes.size());
+  for (size_t n = 0; n < a.nodes.size(); ++n)
+    EXPECT_EQ(a.nodes[n].vertex, b.nodes[n].vertex) << "node " << n;
+  ASSERT_EQ(a.arcs.size(), b.arcs.size());
+  for (size_t i = 0; i < a.arcs.size(); ++i)
+    EXPECT_EQ(a.arcs[i].path, b.arcs[i].path) << "arc " << i;
+}
+
 // The mesh stays valid: no 3D normal flipped w.r.t. the input, each relocated vertex lies on a
 // face of its original 1-ring (so it moved at most one ring).
 void expect_valid_mesh(const TriMesh& original, const TriMesh& mesh) {
@@ -668,14 +691,8 @@ TEST(DiscreteRelocation, ParallelCandidatesGiveTheSequentialResult) {
   const NodeOptResult b =
       relocate_nodes_discrete(in.mesh, start, PipelineOptions{}, parallel, &rec_b);
   EXPECT_LT(a.E_final, a.E_init);
-  ASSERT_EQ(rec_a.steps.size(), rec_b.steps.size());
-  for (size_t k = 0; k < rec_a.steps.size(); ++k) {
-    EXPECT_EQ(rec_a.steps[k].moved_nodes, rec_b.steps[k].moved_nodes) << "step " << k;
-    EXPECT_NEAR(rec_a.steps[k].E, rec_b.steps[k].E, 1e-12 * rec_a.steps[k].E) << "step " << k;
-  }
-  ASSERT_EQ(a.layout.nodes.size(), b.layout.nodes.size());
-  for (size_t n = 0; n < a.layout.nodes.size(); ++n)
-    EXPECT_EQ(a.layout.nodes[n].vertex, b.layout.nodes[n].vertex);
+  expect_same_steps(rec_a.steps, rec_b.steps);
+  expect_same_layout(a.layout, b.layout);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1008,15 +1025,9 @@ TEST(NodeOptimizer, ParallelRetryGivesTheSequentialTrajectory) {
   if (std::thread::hardware_concurrency() >= 2) {
     EXPECT_GT(s_par.parallel_retries, 0);
   }
-  ASSERT_EQ(a.reports.size(), b.reports.size());
-  for (size_t k = 0; k < a.reports.size(); ++k) {
-    EXPECT_EQ(a.reports[k].accepted, b.reports[k].accepted) << "step " << k;
-    EXPECT_NEAR(a.reports[k].E, b.reports[k].E, 1e-12 * a.reports[k].E) << "step " << k;
-  }
+  expect_same_steps(a.reports, b.reports);
   EXPECT_NEAR(a.E_descent, b.E_descent, 1e-12 * a.E_descent);
-  EXPECT_EQ(a.layout.nodes.size(), b.layout.nodes.size());
-  for (size_t n = 0; n < a.layout.nodes.size(); ++n)
-    EXPECT_EQ(a.layout.nodes[n].vertex, b.layout.nodes[n].vertex);
+  expect_same_layout(a.layout, b.layout);
 }
 
 // parallel_fallback solves the state before the polish beside the final state's fold-over
@@ -1052,15 +1063,9 @@ TEST(NodeOptimizer, ParallelFallbackGivesTheSequentialResult) {
     EXPECT_EQ(a.polish_reverted, b.polish_reverted);
     EXPECT_EQ(a.foldovers_final, b.foldovers_final);
     EXPECT_NEAR(a.E_final, b.E_final, 1e-12 * a.E_final);
-    ASSERT_EQ(rec_a.steps.size(), rec_b.steps.size());
-    for (size_t k = 0; k < rec_a.steps.size(); ++k) {
-      EXPECT_EQ(rec_a.steps[k].phase, rec_b.steps[k].phase) << "step " << k;
-      EXPECT_EQ(rec_a.steps[k].foldovers, rec_b.steps[k].foldovers) << "step " << k;
-      EXPECT_NEAR(rec_a.steps[k].E, rec_b.steps[k].E, 1e-12 * rec_a.steps[k].E) << "step " << k;
-    }
-    ASSERT_EQ(a.reports.size(), b.reports.size());
-    for (size_t n = 0; n < a.layout.nodes.size(); ++n)
-      EXPECT_EQ(a.layout.nodes[n].vertex, b.layout.nodes[n].vertex);
+    expect_same_steps(rec_a.steps, rec_b.steps);  // streamed, in order
+    expect_same_steps(a.reports, b.reports);
+    expect_same_layout(a.layout, b.layout);
   }
   EXPECT_GT(reverted, 0) << "no case took the fallback's result";
   if (std::thread::hardware_concurrency() >= 2) {
@@ -1084,19 +1089,9 @@ TEST(NodeOptimizer, ParallelHopsGiveTheSequentialTrajectory) {
   EXPECT_GT(a.hops, 0);
   EXPECT_EQ(a.hops, b.hops);
   EXPECT_EQ(a.hop_rounds, b.hop_rounds);
-  ASSERT_EQ(a.reports.size(), b.reports.size());
-  for (size_t k = 0; k < a.reports.size(); ++k) {
-    EXPECT_EQ(a.reports[k].phase, b.reports[k].phase) << "step " << k;
-    EXPECT_EQ(a.reports[k].accepted, b.reports[k].accepted) << "step " << k;
-    EXPECT_EQ(a.reports[k].moved_nodes, b.reports[k].moved_nodes) << "step " << k;
-    EXPECT_NEAR(a.reports[k].E, b.reports[k].E, 1e-12 * a.reports[k].E) << "step " << k;
-  }
+  expect_same_steps(a.reports, b.reports);
   EXPECT_NEAR(a.E_final, b.E_final, 1e-12 * a.E_final);
-  ASSERT_EQ(a.layout.nodes.size(), b.layout.nodes.size());
-  for (size_t n = 0; n < a.layout.nodes.size(); ++n)
-    EXPECT_EQ(a.layout.nodes[n].vertex, b.layout.nodes[n].vertex);
-  for (size_t i = 0; i < a.layout.arcs.size(); ++i)
-    EXPECT_EQ(a.layout.arcs[i].path, b.layout.arcs[i].path) << "arc " << i;
+  expect_same_layout(a.layout, b.layout);
 }
 
 }  // namespace
