@@ -671,8 +671,8 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
   // The end of the descent at (state, current): fold-over removal, results into `out`.
   // \p fallback: an earlier state will be tried when fold-overs remain here, so an infeasible
   // all-faces orientation round ends this attempt.
-  // \p obs: polled and streamed to (the observer, or nullptr for a speculative attempt whose
-  // reports are streamed later, see try_earlier).
+  // \p obs: polled for cancellation and given the reports (the caller's observer; for the
+  // speculative attempt its stop flag, the reports then streamed later by try_earlier).
   auto finish = [&](const State& st_in, const Evaluation& ev, NodeOptResult& out, bool fallback,
                     Observer* obs) {
     out.pipeline = ev.pipeline;
