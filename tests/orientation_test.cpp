@@ -232,6 +232,36 @@ TEST(OrientationParam, DenseDualAndSparsePrimalSolversAgree) {
   EXPECT_LT(worst, 1e-4);
 }
 
+// OrientationOptions::observer is polled inside the solve, by both solvers: an observer that
+// asks to cancel after k polls stops it with qs::Cancelled (no result, no SolverError), and one
+// that never does sees at least one poll per interior-point iteration.
+TEST(OrientationParam, TheSolvePollsForCancellation) {
+  struct CountingObserver : Observer {
+    mutable int polls = 0;
+    int cancel_after = 1 << 30;
+    bool should_cancel() const override { return ++polls > cancel_after; }
+  };
+  const auto in = test::cube_sphere(6);
+  const Layout layout = displaced(in, 3, 2);
+  for (const int dense_rows : {OrientationOptions{}.dense_max_rows, 0}) {
+    SCOPED_TRACE(dense_rows > 0 ? "dense dual solver" : "sparse primal solver");
+    CountingObserver counting;
+    PipelineOptions o = with_orientation(dense_rows);
+    o.param.orientation.observer = &counting;
+    Pipeline full(in.mesh, layout, o);
+    const Parameterization& p = full.compute_parameterization();
+    ASSERT_GT(p.orientation.iterations, 1);
+    EXPECT_EQ(p.foldovers, 0);
+    EXPECT_GE(counting.polls, p.orientation.iterations);
+    CountingObserver cancelling;
+    cancelling.cancel_after = 1;  // the first round starts; its first loop iteration stops
+    o.param.orientation.observer = &cancelling;
+    Pipeline stopped(in.mesh, layout, o);
+    EXPECT_THROW(stopped.compute_parameterization(), Cancelled);
+    EXPECT_EQ(cancelling.polls, 2);
+  }
+}
+
 // After a sparse round that left fold-overs outside its set (all_faces_after_rounds = 1 here),
 // every face is constrained in the next QP. Its feasible set lies inside that of any smaller
 // set, so its optimum is not below the growing rounds' result; it must still remove every

@@ -690,6 +690,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
       PipelineOptions oriented = options;
       oriented.param.orientation = no.orientation;
       oriented.param.orientation.enabled = true;
+      oriented.param.orientation.observer = obs;  // polled inside the solve (seconds long)
       if (fallback) oriented.param.orientation.stop_if_all_faces_infeasible = true;
       try {
         auto p = std::make_shared<Pipeline>(st_in.mesh, st_in.layout, oriented);
@@ -699,6 +700,7 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
         if (par.orientation.success && par.foldovers < ev.foldovers) {
           out.orientation_constraints = true;
           out.orientation_options = oriented.param.orientation;
+          out.orientation_options.observer = nullptr;  // not valid after this call
           out.E_final =
               unweighted_energy(p->mesh(), p->geometry(), p->field()->theta, par, options.param);
           out.foldovers_final = par.foldovers;

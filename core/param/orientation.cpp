@@ -221,7 +221,8 @@ struct IpmOutcome {
 
 IpmOutcome interior_point(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
                           const Eigen::SparseMatrix<double>& C, const Eigen::VectorXd& d,
-                          Eigen::VectorXd& y, int max_iterations, double tol) {
+                          Eigen::VectorXd& y, int max_iterations, double tol,
+                          const Observer* observer) {
   IpmOutcome out;
   const int m = static_cast<int>(C.rows());
   const Eigen::SparseMatrix<double> Ct = C.transpose();
@@ -287,6 +288,7 @@ IpmOutcome interior_point(const Eigen::SparseMatrix<double>& A, const Eigen::Vec
     return out;
   };
   for (int it = 0; it < max_iterations; ++it) {
+    check_cancel(observer);
     const Eigen::VectorXd rd = A * y - b - Ct * lambda;
     const Eigen::VectorXd rp = C * y - s - d;
     const double mu = s.dot(lambda) / m;
@@ -335,7 +337,8 @@ IpmOutcome interior_point(const Eigen::SparseMatrix<double>& A, const Eigen::Vec
 // conditions s = Sλ + g ≥ 0, λ ≥ 0, s∘λ = 0 are those of the primal QP with y = y0 + Wλ.
 // Newton steps: (S + diag(s/λ)) Δλ = r_c/λ − r_p, Δs = SΔλ + r_p (dense Cholesky).
 IpmOutcome interior_point_dual(const Eigen::MatrixXd& S, const Eigen::VectorXd& g,
-                               Eigen::VectorXd& lambda, int max_iterations, double tol) {
+                               Eigen::VectorXd& lambda, int max_iterations, double tol,
+                               const Observer* observer) {
   IpmOutcome out;
   const int m = static_cast<int>(S.rows());
   lambda = Eigen::VectorXd::Ones(m);
@@ -369,6 +372,7 @@ IpmOutcome interior_point_dual(const Eigen::MatrixXd& S, const Eigen::VectorXd& 
     ++out.iterations;
   }
   for (int it = 0; it < max_iterations; ++it) {
+    check_cancel(observer);
     const Eigen::VectorXd rp = S * lambda + g - s;
     const double mu = s.dot(lambda) / m;
     out.primal_residual = rp.lpNorm<Eigen::Infinity>();
@@ -492,6 +496,7 @@ Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& g,
   Eigen::VectorXd y_round = y;  // the iterate before an all-faces round
   std::vector<char> round_set;
   for (int round = 0; round < o.max_rounds; ++round) {
+    check_cancel(o.observer);
     if (all_faces)
       std::fill(in_set.begin(), in_set.end(), 1);
     else
@@ -511,11 +516,11 @@ Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& g,
       const Eigen::MatrixXd S = h * (rows.C * W);
       const Eigen::VectorXd g = rows.C * y0 - rows.d;
       Eigen::VectorXd lambda;
-      ipm =
-          interior_point_dual(0.5 * (S + S.transpose()), g, lambda, o.max_iterations, o.tolerance);
+      ipm = interior_point_dual(0.5 * (S + S.transpose()), g, lambda, o.max_iterations, o.tolerance,
+                                o.observer);
       y = y0 + h * (W * lambda);
     } else {
-      ipm = interior_point(As, bs, rows.C, rows.d, y, o.max_iterations, o.tolerance);
+      ipm = interior_point(As, bs, rows.C, rows.d, y, o.max_iterations, o.tolerance, o.observer);
       rep.sparse_factorizations += ipm.iterations;
     }
     rep.iterations += ipm.iterations;

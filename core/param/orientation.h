@@ -50,6 +50,7 @@
 #include <string>
 #include <vector>
 
+#include "core/base/progress.h"
 #include "core/base/spd_solver.h"
 #include "core/mesh/geometry.h"
 #include "core/mesh/mesh.h"
@@ -90,6 +91,10 @@ struct OrientationOptions {
   //! back to: the further rounds rarely remove every fold-over there (the 70K bunny after the
   //! hop polish: 147 left after 5 rounds, 15 s), and the earlier state's solve decides anyway.
   bool stop_if_all_faces_infeasible = false;
+  //! Polled before every round and every interior-point iteration (throws qs::Cancelled when it
+  //! asks to cancel): one solve can run for seconds on large models (the 70K bunny: 11 s in
+  //! 3 rounds). Not owned; must outlive the solve; nullptr: never cancelled.
+  const Observer* observer = nullptr;
 };
 
 struct OrientationReport {
