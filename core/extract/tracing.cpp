@@ -376,13 +376,9 @@ Extraction extract_layout(const TriMesh& mesh, const GeometryCache& g, const Lay
   };
   if (opt.second_thread_arcs > 0 && topo.num_arcs >= opt.second_thread_arcs) {
     const int half = topo.num_arcs / 2;
+    // (std::async's future waits in its destructor if the first half throws)
     auto second = std::async(std::launch::async, trace_arcs, half, topo.num_arcs);
-    try {
-      trace_arcs(0, half);
-    } catch (...) {
-      second.wait();
-      throw;
-    }
+    trace_arcs(0, half);
     second.get();
   } else {
     trace_arcs(0, topo.num_arcs);

@@ -106,7 +106,7 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
   HopSweepResult result;
   result.E = E;
   result.foldovers = foldovers;
-  const bool parallel = o.parallel && jobs && *jobs;
+  const bool parallel = jobs && *jobs;
   int failures = 0;  // candidate solves since the last lower E
   struct Candidate {
     Layout layout;         // node n on its candidate vertex (the trial's routing)
@@ -114,6 +114,51 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
     bool solved = false, ok = false;
     double E = 0;
     int foldovers = 0;
+  };
+  // Solves node n's candidates (its vertex v back at \p restored in each) in their order and
+  // keeps the best one below the current E.
+  auto solve_candidates = [&](std::vector<Candidate>& list, int v, const Vec3& restored) {
+    TriMesh moved = mesh;
+    moved.set_point(moved.vertex_handle(v), restored);
+    // Solves candidate k (and k + 1 on a second thread, in parallel mode).
+    auto solve = [&](size_t k) {
+      check_cancel(observer);
+      Candidate& a = list[k];
+      if (parallel && k + 1 < list.size()) {
+        const HopJob first = (*jobs)(moved, a.layout);
+        const HopJob second = (*jobs)(moved, list[k + 1].layout);
+        Candidate& b = list[k + 1];
+        auto other =
+            std::async(std::launch::async, [&second, &b]() { b.ok = second(b.E, b.foldovers); });
+        a.ok = first(a.E, a.foldovers);  // on throw, the future's destructor waits for b
+        other.get();
+        b.solved = true;
+      } else {
+        a.ok = evaluate(moved, a.layout, a.E, a.foldovers);
+      }
+      a.solved = true;
+    };
+    int best = -1;
+    double best_E = result.E;
+    for (size_t k = 0; k < list.size(); ++k) {
+      if (!list[k].solved) solve(k);
+      ++result.evaluations;
+      if (list[k].ok && list[k].E < best_E) {
+        best_E = list[k].E;
+        best = static_cast<int>(k);
+        failures = 0;
+      } else {
+        ++failures;  // a failed solve counts as one without a lower E
+      }
+      if (!list[k].restore && o.max_failures > 0 && failures >= o.max_failures) break;
+    }
+    if (best >= 0) {
+      layout = std::move(list[best].layout);
+      mesh.set_point(mesh.vertex_handle(v), restored);
+      result.E = best_E;
+      result.foldovers = list[best].foldovers;
+      ++result.moved;
+    }
   };
   for (size_t i = 0; i < nodes.size(); ++i) {
     const int n = nodes[i];
@@ -150,53 +195,7 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
       if (!move_node_and_reroute(mesh, c.layout, n, w, o.relocation, context)) continue;
       list.push_back(std::move(c));
     }
-    if (list.empty()) {
-      if (result.evaluations >= o.max_evaluations) break;
-      if (o.max_failures > 0 && failures >= o.max_failures) break;
-      continue;
-    }
-    TriMesh moved = mesh;
-    moved.set_point(moved.vertex_handle(v), restored);
-    // Solves candidate k (and k + 1 on a second thread, in parallel mode).
-    auto solve = [&](size_t k) {
-      check_cancel(observer);
-      if (parallel && k + 1 < list.size()) {
-        const HopJob first = (*jobs)(moved, list[k].layout);
-        const HopJob second = (*jobs)(moved, list[k + 1].layout);
-        Candidate& b = list[k + 1];
-        auto other =
-            std::async(std::launch::async, [&second, &b]() { b.ok = second(b.E, b.foldovers); });
-        Candidate& a = list[k];
-        a.ok = first(a.E, a.foldovers);  // on throw, the future's destructor waits for b
-        other.get();
-        a.solved = b.solved = true;
-        return;
-      }
-      Candidate& a = list[k];
-      a.ok = evaluate(moved, a.layout, a.E, a.foldovers);
-      a.solved = true;
-    };
-    int best = -1;
-    double best_E = result.E;
-    for (size_t k = 0; k < list.size(); ++k) {
-      if (!list[k].solved) solve(k);
-      ++result.evaluations;
-      if (list[k].ok && list[k].E < best_E) {
-        best_E = list[k].E;
-        best = static_cast<int>(k);
-        failures = 0;
-      } else {
-        ++failures;  // a failed solve counts as one without a lower E
-      }
-      if (!list[k].restore && o.max_failures > 0 && failures >= o.max_failures) break;
-    }
-    if (best >= 0) {
-      layout = std::move(list[best].layout);
-      mesh.set_point(mesh.vertex_handle(v), restored);
-      result.E = best_E;
-      result.foldovers = list[best].foldovers;
-      ++result.moved;
-    }
+    if (!list.empty()) solve_candidates(list, v, restored);
     if (result.evaluations >= o.max_evaluations) break;
     if (o.max_failures > 0 && failures >= o.max_failures) break;
   }
@@ -241,15 +240,16 @@ NodeOptResult relocate_nodes_discrete(const TriMesh& mesh, const Layout& layout,
   const HopJobMaker make_job = [&](const TriMesh& m, const Layout& l) -> HopJob {
     return [&, m, l](double& E, int& folds) { return evaluate(m, l, E, folds); };
   };
+  const HopJobMaker* jobs =
+      d.parallel && std::thread::hardware_concurrency() >= 2 ? &make_job : nullptr;
   HopSweepOptions sweep;
   sweep.relocation = d.relocation;
-  sweep.parallel = d.parallel && std::thread::hardware_concurrency() >= 2;
   int evaluations = 0;
   for (int step = 1; step <= d.max_steps && evaluations < d.max_evaluations; ++step) {
     const auto t_step = std::chrono::steady_clock::now();
     sweep.max_evaluations = d.max_evaluations - evaluations;
     const HopSweepResult s = hop_sweep(mesh, result.mesh, result.layout, movable, {}, E, foldovers,
-                                       sweep, evaluate, observer, nullptr, &make_job);
+                                       sweep, evaluate, observer, nullptr, jobs);
     evaluations += s.evaluations;
     E = s.E;
     foldovers = s.foldovers;

@@ -20,7 +20,7 @@ struct DiscreteOptions {
   int max_steps = 25;            //!< sweeps over all nodes
   int max_evaluations = 2000;    //!< total candidate solves (work cap)
   RelocationOptions relocation;  //!< re-routing of the moved node's arcs
-  //! A node's candidates are solved two at a time (HopSweepOptions::parallel) when the machine
+  //! A node's candidates are solved two at a time (hop_sweep's jobs) when the machine
   //! reports two hardware threads; same result as one at a time.
   bool parallel = true;
 };
@@ -68,11 +68,6 @@ struct HopSweepOptions {
   //! The sweep stops after this many candidate solves in a row that found no lower E
   //! (≤ 0: no limit); with the most promising nodes first, the rest rarely pays.
   int max_failures = 0;
-  //! With a HopJobMaker (hop_sweep's \p jobs): a node's candidates are solved two at a time,
-  //! one on a second thread. The candidates and the kept move are those of the one-at-a-time
-  //! order: the results are read in that order, and a solve past the point where the sequential
-  //! sweep would have stopped (max_failures) is discarded, not counted.
-  bool parallel = false;
 };
 
 struct HopSweepResult {
@@ -117,8 +112,11 @@ ConeCandidates cone_candidates(const TriMesh& original, const TriMesh& mesh, con
 //! with the lowest E is kept at once when it is below the current E (\p E at the start).
 //! \p directions is empty (no preference) or has one preferred direction per entry of \p nodes
 //! (3D; a zero vector: no preference for that node). \p mesh and \p layout are updated in
-//! place. \p evaluate solves one candidate on this thread; with HopSweepOptions::parallel, \p jobs
-//! prepares pairs of candidates that are solved side by side (the last odd one by \p evaluate).
+//! place. \p evaluate solves one candidate on this thread. With \p jobs (not null), a node's
+//! candidates are solved two at a time, one on a second thread (the last odd one by
+//! \p evaluate); the candidates and the kept move are those of the one-at-a-time order: the
+//! results are read in that order, and a solve past the point where the sequential sweep would
+//! have stopped (max_failures) is discarded, not counted.
 //! \pre mesh and original have the same connectivity; layout is valid on them.
 //! \throw Cancelled (polled before every solve or pair of solves).
 HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,

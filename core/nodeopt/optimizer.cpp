@@ -41,15 +41,20 @@ Evaluation evaluate_fresh(const TriMesh& mesh, const Layout& layout, const Pipel
   return ev;
 }
 
-// Nodes moved to other vertices (re-routed layout): a Pipeline that reuses \p previous's field
-// solver (update_layout: no analysis, numeric factorizations only for a changed constraint set
-// or a drop pass) and geometry; see Pipeline(mesh, layout, previous).
-Evaluation evaluate_relayout(const Pipeline& previous, const TriMesh& mesh, const Layout& layout,
-                             const PipelineOptions& options) {
-  Evaluation ev;
-  ev.pipeline = std::make_shared<Pipeline>(mesh, layout, previous);
-  solve_and_measure(ev, options);
-  return ev;
+// Runs \p solve (which returns an Evaluation) and gives its E and fold-overs; false when it
+// throws a QsError (a layout the field cannot realize, …). Cancelled passes through.
+template <typename Solve>
+bool measured(Solve&& solve, double& E, int& foldovers) {
+  try {
+    const Evaluation ev = solve();
+    E = ev.E;
+    foldovers = ev.foldovers;
+    return true;
+  } catch (const Cancelled&) {
+    throw;
+  } catch (const QsError&) {
+    return false;
+  }
 }
 
 // Same layout, moved vertices: update the geometry of \p pipeline and re-solve.
@@ -159,13 +164,27 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
   bool current_solved = true;
   // A state whose nodes moved to other vertices (re-routed arcs): a Pipeline continued from the
   // current one (NodeOptOptions::reuse_field), or a fresh one.
-  auto evaluate_switched = [&](const TriMesh& m, const Layout& l) {
+  // The Pipeline of a state whose nodes moved to other vertices (re-routed layout): continued
+  // from the current one (reuse_field: it reuses the field solver, so update_layout needs no
+  // analysis and numeric factorizations only for a changed constraint set or a drop pass, and
+  // the geometry; see Pipeline(mesh, layout, previous)), or fresh. \p own_solvers: the
+  // continued Pipeline copies the field factorizations it shares with the current one, so that
+  // it can be solved on another thread (parallel_hops).
+  auto switched_pipeline = [&](const TriMesh& m, const Layout& l, bool own_solvers) {
     if (no.reuse_field && current.pipeline->field()) {
       ++counters.relayouts;
-      return evaluate_relayout(*current.pipeline, m, l, options);
+      auto p = std::make_shared<Pipeline>(m, l, *current.pipeline);
+      if (own_solvers) p->unshare_solvers();
+      return p;
     }
     ++counters.fresh_pipelines;
-    return evaluate_fresh(m, l, options, false);
+    return std::make_shared<Pipeline>(m, l, options, false);
+  };
+  auto evaluate_switched = [&](const TriMesh& m, const Layout& l) {
+    Evaluation ev;
+    ev.pipeline = switched_pipeline(m, l, false);
+    solve_and_measure(ev, options);
+    return ev;
   };
   // Re-routing keeps the patch count: computed once.
   const RerouteContext reroute = make_reroute_context(mesh, layout);
@@ -220,56 +239,31 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     const auto t_hop = std::chrono::steady_clock::now();
     check_cancel(observer);
     const HopEvaluator evaluate = [&](const TriMesh& m, const Layout& l, double& E, int& folds) {
-      try {
-        const Evaluation ev = evaluate_switched(m, l);
-        E = ev.E;
-        folds = ev.foldovers;
-        return true;
-      } catch (const Cancelled&) {
-        throw;
-      } catch (const QsError&) {
-        return false;
-      }
+      return measured([&] { return evaluate_switched(m, l); }, E, folds);
     };
     // Two at a time (parallel_hops): each job's Pipeline is built here and owns its
     // factorizations before any thread solves it.
     const HopJobMaker make_job = [&](const TriMesh& m, const Layout& l) -> HopJob {
       ++counters.parallel_hop_jobs;
-      if (no.reuse_field && current.pipeline->field()) {
-        std::shared_ptr<Pipeline> p;
-        try {
-          p = std::make_shared<Pipeline>(m, l, *current.pipeline);
-          p->unshare_solvers();
-        } catch (const QsError&) {
-          return [](double&, int&) { return false; };
-        }
-        ++counters.relayouts;
-        return [p, &options](double& E, int& folds) {
-          try {
-            Evaluation ev;
-            ev.pipeline = p;
-            solve_and_measure(ev, options);
-            E = ev.E;
-            folds = ev.foldovers;
-            return true;
-          } catch (const QsError&) {
-            return false;
-          }
-        };
+      std::shared_ptr<Pipeline> p;
+      try {
+        p = switched_pipeline(m, l, true);
+      } catch (const QsError&) {
+        return [](double&, int&) { return false; };
       }
-      ++counters.fresh_pipelines;
-      return [m, l, &options](double& E, int& folds) {
-        try {
-          const Evaluation ev = evaluate_fresh(m, l, options, false);
-          E = ev.E;
-          folds = ev.foldovers;
-          return true;
-        } catch (const QsError&) {
-          return false;
-        }
+      return [p, &options](double& E, int& folds) {
+        return measured(
+            [&] {
+              Evaluation ev;
+              ev.pipeline = p;
+              solve_and_measure(ev, options);
+              return ev;
+            },
+            E, folds);
       };
     };
-    const bool parallel_hops = no.parallel_hops && std::thread::hardware_concurrency() >= 2;
+    const HopJobMaker* jobs =
+        no.parallel_hops && std::thread::hardware_concurrency() >= 2 ? &make_job : nullptr;
     State hopped = state;
     HopSweepResult h;
     h.E = current.E;
@@ -279,11 +273,10 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     auto run_sweep = [&](const std::vector<int>& nodes, const std::vector<Vec3>& directions,
                          HopSweepOptions sweep, bool counts_evaluations) {
       sweep.relocation = no.relocation;
-      sweep.parallel = parallel_hops;
       if (nodes.empty() || sweep.max_evaluations <= 0) return;
       const HopSweepResult s =
           hop_sweep(original, hopped.mesh, hopped.layout, nodes, directions, h.E, h.foldovers,
-                    sweep, evaluate, observer, &reroute, &make_job);
+                    sweep, evaluate, observer, &reroute, jobs);
       h.moved += s.moved;
       if (counts_evaluations) h.evaluations += s.evaluations;
       h.E = s.E;

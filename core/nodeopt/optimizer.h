@@ -97,7 +97,7 @@ struct NodeOptOptions {
   //! limit): on large models most of the budget would otherwise be spent without gain.
   int hop_max_failures = 16;
   //! A node's hop candidates are solved two at a time, one on a second thread
-  //! (HopSweepOptions::parallel), when the machine reports two hardware threads. Each candidate's
+  //! (hop_sweep's jobs), when the machine reports two hardware threads. Each candidate's
   //! continued Pipeline copies its field factorizations (Pipeline::unshare_solvers) before it
   //! is solved. Same candidates, same kept moves, same result as one at a time.
   bool parallel_hops = true;

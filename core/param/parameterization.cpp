@@ -145,14 +145,10 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
   for (int n = 0; n < topo.num_nodes; ++n)
     if (topo.valence[n] != 4) singular[layout.nodes[n].vertex] = 1;
   if (options_.second_thread) {  // independent: the labels on a second thread
+    // (std::async's future waits in its destructor if the cut graph throws)
     auto labels = std::async(std::launch::async,
                              [&]() { return label_layout(mesh, g, layout, topo, p, theta); });
-    try {
-      cut_ = build_cut_graph(mesh, g, p, singular);
-    } catch (...) {
-      labels.wait();
-      throw;
-    }
+    cut_ = build_cut_graph(mesh, g, p, singular);
     labeling_ = labels.get();
   } else {
     cut_ = build_cut_graph(mesh, g, p, singular);
@@ -382,12 +378,10 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
             options_.sizing.exclude_singular_faces)
       sizing_ = std::move(previous->sizing_);
   }
-  if (solve_now) {
+  if (solve_now)
     solve(mesh, g, theta);
-  } else if (options_.second_thread) {  // the first factorization's analysis, meanwhile
-    hint_ordering(assembly_.A());
-    solver_.begin_analysis(assembly_.A());
-  }
+  else
+    begin_analysis();  // the first factorization's, meanwhile
 }
 
 ParamSolver::~ParamSolver() = default;
@@ -408,6 +402,12 @@ std::vector<ArcLength> ParamSolver::arc_lengths() const {
     out.push_back({span.arc_id, value});
   }
   return out;
+}
+
+void ParamSolver::begin_analysis() {
+  if (!options_.second_thread) return;
+  hint_ordering(assembly_.A());
+  solver_.begin_analysis(assembly_.A());
 }
 
 void ParamSolver::hint_ordering(const Eigen::SparseMatrix<double>& A) {
@@ -448,10 +448,7 @@ const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCa
   const int n = system_.variables;
   const double aniso = options_.anisotropic ? options_.anisotropy : 1.0;
   // A's pattern is fixed (ReducedAssembly): a new one is analyzed while the values are filled.
-  if (options_.second_thread) {
-    hint_ordering(assembly_.A());
-    solver_.begin_analysis(assembly_.A());
-  }
+  begin_analysis();
   // Until factorize() collects it, the analysis reads A's pattern: wait for it on every exit.
   struct WaitForAnalysis {
     const SpdSolver& solver;

@@ -119,11 +119,6 @@ class ParamSolver {
   double optimal_field_rotation(const TriMesh& mesh, const GeometryCache& geometry,
                                 const std::vector<double>& theta);
 
-  //! Orientation constraints for the following solves (ParamOptions::orientation).
-  void set_orientation(const OrientationOptions& orientation) {
-    options_.orientation = orientation;
-  }
-
   const Parameterization& result() const { return result_; }
   //! The signed parametric length of every arc with two end nodes, measured on the current
   //! result (same conventions as ParamOptions::arc_lengths), in layout arc order.
@@ -162,6 +157,9 @@ class ParamSolver {
   //! With ParamOptions::wedge_ordering, hands the wedge-graph ordering of \p A to the linear
   //! solver when its next factorization analyzes (A's pattern is not the analyzed one).
   void hint_ordering(const Eigen::SparseMatrix<double>& A);
+  //! With ParamOptions::second_thread: starts the analysis of A's pattern on the second thread
+  //! (SpdSolver::begin_analysis; a no-op for the analyzed pattern), hint included.
+  void begin_analysis();
 };
 
 //! Energy (1) per face for given corner values (same conventions as the solver), without
