@@ -7,6 +7,7 @@
 #include <exception>
 #include <future>
 #include <memory>
+#include <stdexcept>
 #include <thread>
 
 #include "core/base/timing.h"
@@ -132,65 +133,79 @@ std::vector<int> movable_nodes(const TriMesh& mesh, const Layout& layout) {
   return out;
 }
 
-NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
-                             const PipelineOptions& options, const NodeOptOptions& no,
-                             Observer* observer, std::shared_ptr<Pipeline> start,
-                             NodeOptStats* stats) {
-  const auto t_start = std::chrono::steady_clock::now();
-  const TriMesh& original = mesh;
+// The optimization's state between units (NodeOptimizer::step), and the units themselves.
+struct NodeOptimizer::Impl {
+  const PipelineOptions options;
+  const NodeOptOptions no;
+  const std::chrono::steady_clock::time_point t_start = std::chrono::steady_clock::now();
+  const TriMesh original;        // the input positions (each relocated vertex lies on this surface)
+  Observer* observer = nullptr;  // the caller's, for the current step() or finish()
   NodeOptResult result;
   NodeOptStats counters;
-  State state{mesh, layout, {}};
-  for (const auto& n : layout.nodes) state.anchor.push_back(vertex_surface_point(mesh, n.vertex));
-  const std::vector<int> movable = movable_nodes(mesh, layout);
-  const GeometryCache original_geometry = build_geometry(mesh);
-  const double mean_edge = original_geometry.mean_edge_length;
-
-  check_cancel(observer);
+  State state;
+  std::vector<int> movable;
+  const GeometryCache original_geometry;
+  const double mean_edge;
   Evaluation current;
-  if (start && pipeline_matches(*start, mesh, layout)) {
-    current.pipeline = std::move(start);
-    current.E = unweighted_energy(current.pipeline->mesh(), current.pipeline->geometry(),
-                                  current.pipeline->field()->theta,
-                                  *current.pipeline->parameterization(), options.param);
-    current.foldovers = current.pipeline->parameterization()->foldovers;
-    counters.warm_start = true;
-  } else {
-    current = evaluate_fresh(state.mesh, state.layout, options, true);
-    ++counters.fresh_pipelines;
-  }
   // False when current.pipeline was re-solved for a rejected trial (it then holds the trial's
   // positions, not state's).
   bool current_solved = true;
-  // A state whose nodes moved to other vertices (re-routed arcs): a Pipeline continued from the
-  // current one (NodeOptOptions::reuse_field), or a fresh one.
-  // The Pipeline of a state whose nodes moved to other vertices (re-routed layout): continued
-  // from the current one (reuse_field: it reuses the field solver, so update_layout needs no
-  // analysis and numeric factorizations only for a changed constraint set or a drop pass, and
-  // the geometry; see Pipeline(mesh, layout, previous)), or fresh. \p own_solvers: the
-  // continued Pipeline copies the field factorizations it shares with the current one, so that
-  // it can be solved on another thread (parallel_hops).
-  auto switched_pipeline = [&](const TriMesh& m, const Layout& l, bool own_solvers) {
-    if (no.reuse_field && current.pipeline->field()) {
-      ++counters.relayouts;
-      auto p = std::make_shared<Pipeline>(m, l, *current.pipeline);
-      if (own_solvers) p->unshare_solvers();
-      return p;
-    }
-    ++counters.fresh_pipelines;
-    return std::make_shared<Pipeline>(m, l, options, false);
-  };
-  auto evaluate_switched = [&](const TriMesh& m, const Layout& l) {
-    Evaluation ev;
-    ev.pipeline = switched_pipeline(m, l, false);
-    solve_and_measure(ev, options);
-    return ev;
-  };
   // Re-routing keeps the patch count: computed once.
-  const RerouteContext reroute = make_reroute_context(mesh, layout);
-  result.E_init = current.E;
-  result.foldovers_init = current.foldovers;
-  {
+  const RerouteContext reroute;
+  double alpha;
+  // Gradients and node-Voronoi cells depend on the state only: kept across rejected steps.
+  std::vector<Vec3> grad;
+  double scale = 1;
+  std::vector<int> cell;
+  bool state_changed = true;
+  // Descent phases: the first has max_steps steps; a hop sweep that moves nodes starts a new
+  // one (α reset) with at least hop_descent_steps more.
+  int step_budget;
+  std::unique_ptr<State> pre_polish;  // the state before the first kept hop
+  // The accepted state with the fewest fold-overs (equal: the later, lower E), kept while the
+  // current state has more: the second fallback of the fold-over removal.
+  std::unique_ptr<State> fewest_folds;
+  int fewest_folds_count = 0;
+  int phase_halvings = 0;
+  // Per movable node: the vertex it switched to in the last trial rejected at the current α, or
+  // -1 (switch_tabu); and the targets of the trial being built.
+  std::vector<int> rejected_target, target;
+  std::vector<double> deficits;  // angle deficits of the original mesh (hop_cones), on demand
+  int polish_rounds = 0;         // sweeps after a descent phase (max_hop_rounds)
+  bool started = false;          // the sweep before the descent (hop_cones_first) is done
+  bool descent_over = false;     // no further unit: finish() remains
+  bool finished = false;
+
+  Impl(const TriMesh& mesh, const Layout& layout, const PipelineOptions& options_in,
+       const NodeOptOptions& no_in, Observer* obs, std::shared_ptr<Pipeline> start)
+      : options(options_in),
+        no(no_in),
+        original(mesh),
+        observer(obs),
+        state{mesh, layout, {}},
+        movable(movable_nodes(mesh, layout)),
+        original_geometry(build_geometry(mesh)),
+        mean_edge(original_geometry.mean_edge_length),
+        reroute(make_reroute_context(mesh, layout)),
+        alpha(no_in.alpha),
+        step_budget(no_in.max_steps) {
+    for (const auto& n : layout.nodes) state.anchor.push_back(vertex_surface_point(mesh, n.vertex));
+    check_cancel(observer);
+    if (start && pipeline_matches(*start, mesh, layout)) {
+      current.pipeline = std::move(start);
+      current.E = unweighted_energy(current.pipeline->mesh(), current.pipeline->geometry(),
+                                    current.pipeline->field()->theta,
+                                    *current.pipeline->parameterization(), options.param);
+      current.foldovers = current.pipeline->parameterization()->foldovers;
+      counters.warm_start = true;
+    } else {
+      current = evaluate_fresh(state.mesh, state.layout, options, true);
+      ++counters.fresh_pipelines;
+    }
+    rejected_target.assign(movable.size(), -1);
+    fewest_folds_count = current.foldovers;
+    result.E_init = current.E;
+    result.foldovers_init = current.foldovers;
     StepReport r;
     r.step = 0;
     r.E = current.E;
@@ -202,40 +217,45 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     emit_step(r, state.mesh, state.layout, result.reports, observer);
   }
 
-  double alpha = no.alpha;
-  // Gradients and node-Voronoi cells depend on the state only: kept across rejected steps.
-  std::vector<Vec3> grad;
-  double scale = 1;
-  std::vector<int> cell;
-  bool state_changed = true;
-  // Descent phases: the first has max_steps steps; a hop sweep that moves nodes starts a new
-  // one (α reset) with at least hop_descent_steps more.
-  int step_budget = no.max_steps;
-  std::unique_ptr<State> pre_polish;  // the state before the first kept hop
-  // The accepted state with the fewest fold-overs (equal: the later, lower E), kept while the
-  // current state has more: the second fallback of the fold-over removal.
-  std::unique_ptr<State> fewest_folds;
-  int fewest_folds_count = current.foldovers;
-  auto note_fold_count = [&](const State& before, int after_folds) {
+  // The Pipeline of a state whose nodes moved to other vertices (re-routed layout): continued
+  // from the current one (reuse_field: it reuses the field solver, so update_layout needs no
+  // analysis and numeric factorizations only for a changed constraint set or a drop pass, and
+  // the geometry; see Pipeline(mesh, layout, previous)), or fresh. \p own_solvers: the
+  // continued Pipeline copies the field factorizations it shares with the current one, so that
+  // it can be solved on another thread (parallel_hops).
+  std::shared_ptr<Pipeline> switched_pipeline(const TriMesh& m, const Layout& l, bool own_solvers) {
+    if (no.reuse_field && current.pipeline->field()) {
+      ++counters.relayouts;
+      auto p = std::make_shared<Pipeline>(m, l, *current.pipeline);
+      if (own_solvers) p->unshare_solvers();
+      return p;
+    }
+    ++counters.fresh_pipelines;
+    return std::make_shared<Pipeline>(m, l, options, false);
+  }
+
+  Evaluation evaluate_switched(const TriMesh& m, const Layout& l) {
+    Evaluation ev;
+    ev.pipeline = switched_pipeline(m, l, false);
+    solve_and_measure(ev, options);
+    return ev;
+  }
+
+  void note_fold_count(const State& before, int after_folds) {
     if (after_folds <= fewest_folds_count) {  // the new state is the best (equal: lower E)
       fewest_folds.reset();
       fewest_folds_count = after_folds;
     } else if (!fewest_folds) {  // leaving the best state
       fewest_folds = std::make_unique<State>(before);
     }
-  };
-  int phase_halvings = 0;
-  // Per movable node: the vertex it switched to in the last trial rejected at the current α, or
-  // -1 (switch_tabu); and the targets of the trial being built.
-  std::vector<int> rejected_target(movable.size(), -1), target;
+  }
+
   // Hop sweep (discrete.h; NodeOptOptions::hop_polish): all relocations undone at once, cone
   // restores and hops, then relocated nodes try the neighbours in the direction of their
-  // relocation. Returns true when E fell (state and current updated).
-  std::vector<double> deficits;  // angle deficits of the original mesh (hop_cones), on demand
-  // \p cones_only: the sweep before the descent (hop_cones_first): only the collective and cone
-  // passes, and nothing (no solve, no report) when no node has a cone candidate.
-  int polish_rounds = 0;  // sweeps after a descent phase (max_hop_rounds)
-  auto hop_round = [&](bool cones_only) {
+  // relocation. Returns true when E fell (state and current updated). \p cones_only: the sweep
+  // before the descent (hop_cones_first): only the collective and cone passes, and nothing (no
+  // solve, no report) when no node has a cone candidate.
+  bool hop_round(bool cones_only) {
     const auto t_hop = std::chrono::steady_clock::now();
     check_cancel(observer);
     const HopEvaluator evaluate = [&](const TriMesh& m, const Layout& l, double& E, int& folds) {
@@ -251,12 +271,13 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
       } catch (const QsError&) {
         return [](double&, int&) { return false; };
       }
-      return [p, &options](double& E, int& folds) {
+      const PipelineOptions* opts = &options;
+      return [p, opts](double& E, int& folds) {
         return measured(
             [&] {
               Evaluation ev;
               ev.pipeline = p;
-              solve_and_measure(ev, options);
+              solve_and_measure(ev, *opts);
               return ev;
             },
             E, folds);
@@ -400,9 +421,10 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     r.phase = "hop";
     emit_step(r, state.mesh, state.layout, result.reports, observer);
     return kept;
-  };
+  }
+
   // When a descent phase ends: a hop sweep; true when nodes hopped and a new phase begins.
-  auto polish = [&]() {
+  bool polish() {
     if (!no.hop_polish || polish_rounds >= no.max_hop_rounds) return false;
     ++polish_rounds;
     if (!hop_round(false)) return false;
@@ -411,12 +433,26 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     std::fill(rejected_target.begin(), rejected_target.end(), -1);
     step_budget = std::max(step_budget, result.steps + no.hop_descent_steps);
     return true;
-  };
-  if (no.hop_polish && no.hop_cones_first && !movable.empty()) hop_round(true);
-  while (!movable.empty()) {
-    if (result.steps >= step_budget || phase_halvings > no.max_halvings) {
-      if (polish()) continue;
-      break;
+  }
+
+  // One unit of the optimization: the sweep before the descent (hop_cones_first, when it
+  // runs), then a descent step, or the hop sweep that ends a descent phase. False when the
+  // descent and the polish are over (finish() remains); a last sweep that kept nothing may have
+  // run and been reported in that call.
+  bool step() {
+    if (descent_over) return false;
+    if (!started) {
+      started = true;
+      if (no.hop_polish && no.hop_cones_first && !movable.empty()) {
+        const int rounds = result.hop_rounds;
+        hop_round(true);
+        if (result.hop_rounds > rounds) return true;
+      }
+    }
+    if (movable.empty() || result.steps >= step_budget || phase_halvings > no.max_halvings) {
+      if (!movable.empty() && polish()) return true;
+      descent_over = true;
+      return false;
     }
     check_cancel(observer);
     const auto t_step = std::chrono::steady_clock::now();
@@ -523,8 +559,9 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
       r.foldovers = current.foldovers;
       r.time_s = seconds_since(t_step);
       emit_step(r, state.mesh, state.layout, result.reports, observer);
-      if (polish()) continue;
-      break;
+      if (polish()) return true;
+      descent_over = true;
+      return false;
     }
     Evaluation next;
     // Mostly the switches of a trial rejected at this α: rejected again without a solve, the
@@ -566,10 +603,10 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
         if (p) {
           ++counters.relayouts;
           ++counters.parallel_retries;
-          auto first = std::async(std::launch::async, [p, &options]() {
+          auto first = std::async(std::launch::async, [p, opts = &options]() {
             Evaluation ev;
             ev.pipeline = p;
-            solve_and_measure(ev, options);
+            solve_and_measure(ev, *opts);
             return ev;
           });
           second_ok = try_evaluate(retry, retry_switched, second);  // waits for first if it throws
@@ -623,187 +660,294 @@ NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
     }
     r.time_s = seconds_since(t_step);
     emit_step(r, state.mesh, state.layout, result.reports, observer);
+    return true;
   }
-  if (!current_solved) {  // the last trial re-solved the Pipeline in place and was rejected
+
+  // The last trial re-solved the current Pipeline in place and was rejected: solve it at the
+  // state again.
+  void solve_current() {
+    if (current_solved) return;
     check_cancel(observer);
     current.pipeline->update_positions(state.mesh);
     current.pipeline->compute_field();
     current.pipeline->compute_parameterization();
     ++counters.reused_solves;
+    current_solved = true;
   }
-  // Stiffening (§7.1) of state \p st (its descent solve: \p descent) into \p out when it leaves
-  // fewer fold-overs than out's result.
-  auto stiffen_into = [&](const State& st, const std::shared_ptr<Pipeline>& descent,
-                          NodeOptResult& out) {
-    const auto t_st = std::chrono::steady_clock::now();
-    const StiffeningResult sr = stiffen(st.mesh, st.layout, options, no.stiffening, observer);
-    out.stiffening_iterations = sr.iterations;
-    if (sr.foldovers_after < out.foldovers_final) {
-      out.orientation_constraints = false;
-      out.pipeline = descent;
-      out.face_weights = sr.face_weights;
-      out.E_final = sr.E_after;
-      out.foldovers_final = sr.foldovers_after;
-    }
-    StepReport r;
-    r.step = result.steps + result.hop_rounds + 1;
-    r.E = out.E_final;
-    r.accepted = !out.face_weights.empty();
-    r.step_size = 0;
-    r.foldovers = out.foldovers_final;
-    r.time_s = seconds_since(t_st);
-    r.phase = "stiffening";
-    emit_step(r, st.mesh, st.layout, out.reports, observer);
-  };
-  // Earlier states the fold-over removal falls back to (try_earlier below). With one, stiffening
-  // waits until every state's orientation solve was tried: it is the costlier fallback and
-  // rarely removes what the constraints could not (the 70K bunny after the polish: 147 → 142
-  // fold-overs in 5.6 s), while the orientation solve at an earlier state often succeeds.
-  const bool try_fewest = fewest_folds && fewest_folds_count < current.foldovers;
-  const bool has_earlier = no.orientation_at_end && (pre_polish || try_fewest);
-  // The end of the descent at (state, current): fold-over removal, results into `out`.
-  // \p fallback: an earlier state will be tried when fold-overs remain here, so an infeasible
-  // all-faces orientation round ends this attempt.
-  // \p obs: polled for cancellation and given the reports (the caller's observer; for the
-  // speculative attempt its stop flag, the reports then streamed later by try_earlier).
-  auto finish = [&](const State& st_in, const Evaluation& ev, NodeOptResult& out, bool fallback,
-                    Observer* obs) {
-    out.pipeline = ev.pipeline;
-    out.descent_pipeline = ev.pipeline;
-    out.E_descent = ev.E;
-    out.foldovers_descent = ev.foldovers;
-    out.E_final = ev.E;
-    out.foldovers_final = ev.foldovers;
 
-    // Fold-over removal: strict orientation constraints in the last solve (algorithm.md §7.2),
-    // stiffening (§7.1) only as the fallback when fold-overs remain.
-    if (no.orientation_at_end && ev.foldovers > 0) {
-      const auto t_or = std::chrono::steady_clock::now();
-      check_cancel(obs);
-      PipelineOptions oriented = options;
-      oriented.param.orientation = no.orientation;
-      oriented.param.orientation.enabled = true;
-      oriented.param.orientation.observer = obs;  // polled inside the solve (seconds long)
-      if (fallback) oriented.param.orientation.stop_if_all_faces_infeasible = true;
-      try {
-        auto p = std::make_shared<Pipeline>(st_in.mesh, st_in.layout, oriented);
-        p->compute_field();
-        const Parameterization& par = p->compute_parameterization();
-        out.orientation = par.orientation;
-        if (par.orientation.success && par.foldovers < ev.foldovers) {
-          out.orientation_constraints = true;
-          out.orientation_options = oriented.param.orientation;
-          out.orientation_options.observer = nullptr;  // not valid after this call
-          out.E_final =
-              unweighted_energy(p->mesh(), p->geometry(), p->field()->theta, par, options.param);
-          out.foldovers_final = par.foldovers;
-          out.pipeline = std::move(p);
-        }
-      } catch (const Cancelled&) {
-        throw;
-      } catch (const QsError& e) {
-        out.orientation.message = e.what();
+  // Pins changed between steps (NodeOptimizer::set_pinned).
+  void set_pinned(const std::vector<char>& pinned) {
+    bool changed = false;
+    for (size_t n = 0; n < state.layout.nodes.size() && n < pinned.size(); ++n) {
+      LayoutNode& node = state.layout.nodes[n];
+      if (node.pinned == bool(pinned[n])) continue;
+      changed = true;
+      node.pinned = pinned[n];
+      // An earlier state where a newly pinned node stands elsewhere is no fallback any more.
+      const auto vh = original.vertex_handle(node.vertex);
+      for (std::unique_ptr<State>* earlier : {&pre_polish, &fewest_folds}) {
+        if (!*earlier) continue;
+        State& st = **earlier;
+        st.layout.nodes[n].pinned = node.pinned;
+        if (node.pinned &&
+            (st.layout.nodes[n].vertex != node.vertex || st.mesh.point(vh) != state.mesh.point(vh)))
+          earlier->reset();
+      }
+    }
+    if (!changed) return;
+    movable = movable_nodes(original, state.layout);
+    rejected_target.assign(movable.size(), -1);
+    state_changed = true;  // gradients of the new movable set
+  }
+
+  // The end of the optimization at the current state: fold-over removal (orientation
+  // constraints, earlier states, stiffening) and the result.
+  NodeOptResult finish(NodeOptStats* stats) {
+    descent_over = true;
+    finished = true;
+    solve_current();
+    // Stiffening (§7.1) of state \p st (its descent solve: \p descent) into \p out when it leaves
+    // fewer fold-overs than out's result.
+    auto stiffen_into = [&](const State& st, const std::shared_ptr<Pipeline>& descent,
+                            NodeOptResult& out) {
+      const auto t_st = std::chrono::steady_clock::now();
+      const StiffeningResult sr = stiffen(st.mesh, st.layout, options, no.stiffening, observer);
+      out.stiffening_iterations = sr.iterations;
+      if (sr.foldovers_after < out.foldovers_final) {
+        out.orientation_constraints = false;
+        out.pipeline = descent;
+        out.face_weights = sr.face_weights;
+        out.E_final = sr.E_after;
+        out.foldovers_final = sr.foldovers_after;
       }
       StepReport r;
       r.step = result.steps + result.hop_rounds + 1;
       r.E = out.E_final;
-      r.accepted = out.orientation_constraints;
+      r.accepted = !out.face_weights.empty();
+      r.step_size = 0;
       r.foldovers = out.foldovers_final;
-      r.time_s = seconds_since(t_or);
-      r.phase = "orientation";
-      emit_step(r, st_in.mesh, st_in.layout, out.reports, obs);
-    }
-    if (no.stiffen_at_end && out.foldovers_final > 0 && !has_earlier)
-      stiffen_into(st_in, ev.pipeline, out);
-  };
-  // The fold-over removal at the state before the polish, solved speculatively
-  // (parallel_fallback). Declared after the lambda and the states it reads: its destructor
-  // waits for it before they go away. `stop` ends it at its next poll once it is not needed.
-  struct Speculative {
-    Evaluation evaluation;
-    NodeOptResult result;
-    std::exception_ptr error;
-  };
-  struct StopFlag : Observer {
-    std::atomic<bool> stop{false};
-    bool should_cancel() const override { return stop.load(); }
-  } speculative_stop;
-  std::future<Speculative> speculative;
-  struct StopOnExit {  // also on an exception: the future's destructor then waits less
-    StopFlag& flag;
-    ~StopOnExit() { flag.stop = true; }
-  } stop_on_exit{speculative_stop};
-  // parallel_fallback: the state before the polish is solved and oriented on a second thread
-  // while this one orients the final state; its result (and its reports) are used exactly when
-  // the sequential order would have tried it.
-  if (no.orientation_at_end && pre_polish && current.foldovers > 0 && no.parallel_fallback &&
-      std::thread::hardware_concurrency() >= 2) {
-    const State* earlier = pre_polish.get();
-    const bool later = try_fewest;
-    speculative = std::async(std::launch::async, [&, earlier, later]() {
-      Speculative out;
-      try {
-        out.evaluation = evaluate_fresh(earlier->mesh, earlier->layout, options, false);
-        check_cancel(&speculative_stop);
-        finish(*earlier, out.evaluation, out.result, later, &speculative_stop);
-      } catch (...) {
-        out.error = std::current_exception();
+      r.time_s = seconds_since(t_st);
+      r.phase = "stiffening";
+      emit_step(r, st.mesh, st.layout, out.reports, observer);
+    };
+    // Earlier states the fold-over removal falls back to (try_earlier below). With one, stiffening
+    // waits until every state's orientation solve was tried: it is the costlier fallback and
+    // rarely removes what the constraints could not (the 70K bunny after the polish: 147 → 142
+    // fold-overs in 5.6 s), while the orientation solve at an earlier state often succeeds.
+    const bool try_fewest = fewest_folds && fewest_folds_count < current.foldovers;
+    const bool has_earlier = no.orientation_at_end && (pre_polish || try_fewest);
+    // The end of the descent at (state, current): fold-over removal, results into `out`.
+    // \p fallback: an earlier state will be tried when fold-overs remain here, so an infeasible
+    // all-faces orientation round ends this attempt.
+    // \p obs: polled for cancellation and given the reports (the caller's observer; for the
+    // speculative attempt its stop flag, the reports then streamed later by try_earlier).
+    auto remove_foldovers = [&](const State& st_in, const Evaluation& ev, NodeOptResult& out,
+                                bool fallback, Observer* obs) {
+      out.pipeline = ev.pipeline;
+      out.descent_pipeline = ev.pipeline;
+      out.E_descent = ev.E;
+      out.foldovers_descent = ev.foldovers;
+      out.E_final = ev.E;
+      out.foldovers_final = ev.foldovers;
+
+      // Fold-over removal: strict orientation constraints in the last solve (algorithm.md §7.2),
+      // stiffening (§7.1) only as the fallback when fold-overs remain.
+      if (no.orientation_at_end && ev.foldovers > 0) {
+        const auto t_or = std::chrono::steady_clock::now();
+        check_cancel(obs);
+        PipelineOptions oriented = options;
+        oriented.param.orientation = no.orientation;
+        oriented.param.orientation.enabled = true;
+        oriented.param.orientation.observer = obs;  // polled inside the solve (seconds long)
+        if (fallback) oriented.param.orientation.stop_if_all_faces_infeasible = true;
+        try {
+          auto p = std::make_shared<Pipeline>(st_in.mesh, st_in.layout, oriented);
+          p->compute_field();
+          const Parameterization& par = p->compute_parameterization();
+          out.orientation = par.orientation;
+          if (par.orientation.success && par.foldovers < ev.foldovers) {
+            out.orientation_constraints = true;
+            out.orientation_options = oriented.param.orientation;
+            out.orientation_options.observer = nullptr;  // not valid after this call
+            out.E_final =
+                unweighted_energy(p->mesh(), p->geometry(), p->field()->theta, par, options.param);
+            out.foldovers_final = par.foldovers;
+            out.pipeline = std::move(p);
+          }
+        } catch (const Cancelled&) {
+          throw;
+        } catch (const QsError& e) {
+          out.orientation.message = e.what();
+        }
+        StepReport r;
+        r.step = result.steps + result.hop_rounds + 1;
+        r.E = out.E_final;
+        r.accepted = out.orientation_constraints;
+        r.foldovers = out.foldovers_final;
+        r.time_s = seconds_since(t_or);
+        r.phase = "orientation";
+        emit_step(r, st_in.mesh, st_in.layout, out.reports, obs);
       }
-      return out;
-    });
+      if (no.stiffen_at_end && out.foldovers_final > 0 && !has_earlier)
+        stiffen_into(st_in, ev.pipeline, out);
+    };
+    // The fold-over removal at the state before the polish, solved speculatively
+    // (parallel_fallback). Declared after the lambda and the states it reads: its destructor
+    // waits for it before they go away. `stop` ends it at its next poll once it is not needed.
+    struct Speculative {
+      Evaluation evaluation;
+      NodeOptResult result;
+      std::exception_ptr error;
+    };
+    struct StopFlag : Observer {
+      std::atomic<bool> stop{false};
+      bool should_cancel() const override { return stop.load(); }
+    } speculative_stop;
+    std::future<Speculative> speculative;
+    struct StopOnExit {  // also on an exception: the future's destructor then waits less
+      StopFlag& flag;
+      ~StopOnExit() { flag.stop = true; }
+    } stop_on_exit{speculative_stop};
+    // parallel_fallback: the state before the polish is solved and oriented on a second thread
+    // while this one orients the final state; its result (and its reports) are used exactly when
+    // the sequential order would have tried it.
+    if (no.orientation_at_end && pre_polish && current.foldovers > 0 && no.parallel_fallback &&
+        std::thread::hardware_concurrency() >= 2) {
+      const State* earlier = pre_polish.get();
+      const bool later = try_fewest;
+      speculative = std::async(std::launch::async, [&, earlier, later]() {
+        Speculative out;
+        try {
+          out.evaluation = evaluate_fresh(earlier->mesh, earlier->layout, options, false);
+          check_cancel(&speculative_stop);
+          remove_foldovers(*earlier, out.evaluation, out.result, later, &speculative_stop);
+        } catch (...) {
+          out.error = std::current_exception();
+        }
+        return out;
+      });
+    }
+    remove_foldovers(state, current, result, has_earlier, observer);
+    if (result.foldovers_final == 0) speculative_stop.stop = true;  // not needed
+    // The descent and the polish lower E but can end where the fold-over removal fails although
+    // it succeeds at an earlier state: the state before the first hop, then the accepted state
+    // with the fewest fold-overs, are tried; a result with fewer fold-overs (equal: lower final
+    // E) is taken.
+    // \p later: another earlier state follows this one.
+    auto try_earlier = [&](std::unique_ptr<State>& earlier, bool& flag, bool later) {
+      if (result.foldovers_final == 0 || !earlier) return;
+      check_cancel(observer);
+      NodeOptResult alt;
+      if (speculative.valid() && earlier == pre_polish) {
+        Speculative done = speculative.get();
+        if (done.error) std::rethrow_exception(done.error);
+        alt = std::move(done.result);
+        ++counters.parallel_fallbacks;
+        if (observer)  // streamed now, in the order of the sequential attempt
+          for (const StepReport& r : alt.reports) observer->on_step(r);
+      } else {
+        Evaluation ev = evaluate_fresh(earlier->mesh, earlier->layout, options, false);
+        remove_foldovers(*earlier, ev, alt, later, observer);
+      }
+      ++counters.fresh_pipelines;
+      result.reports.insert(result.reports.end(), alt.reports.begin(), alt.reports.end());
+      if (alt.foldovers_final < result.foldovers_final ||
+          (alt.foldovers_final == result.foldovers_final && alt.E_final < result.E_final)) {
+        state = std::move(*earlier);
+        result.pipeline = alt.pipeline;
+        result.descent_pipeline = alt.descent_pipeline;
+        result.E_descent = alt.E_descent;
+        result.foldovers_descent = alt.foldovers_descent;
+        result.E_final = alt.E_final;
+        result.foldovers_final = alt.foldovers_final;
+        result.orientation_constraints = alt.orientation_constraints;
+        result.orientation_options = alt.orientation_options;
+        result.orientation = alt.orientation;
+        result.face_weights = alt.face_weights;
+        result.stiffening_iterations = alt.stiffening_iterations;
+        flag = true;
+      }
+      earlier.reset();
+    };
+    if (!no.orientation_at_end && !no.stiffen_at_end) pre_polish.reset(), fewest_folds.reset();
+    try_earlier(pre_polish, result.polish_reverted, try_fewest);
+    if (try_fewest) try_earlier(fewest_folds, result.fewest_foldovers_reverted, false);
+    if (has_earlier && no.stiffen_at_end && result.foldovers_final > 0)
+      stiffen_into(state, result.descent_pipeline, result);
+    if (stats) *stats = counters;
+    result.mesh = std::move(state.mesh);
+    result.layout = std::move(state.layout);
+    result.time_s = seconds_since(t_start);
+    return std::move(result);
   }
-  finish(state, current, result, has_earlier, observer);
-  if (result.foldovers_final == 0) speculative_stop.stop = true;  // not needed
-  // The descent and the polish lower E but can end where the fold-over removal fails although
-  // it succeeds at an earlier state: the state before the first hop, then the accepted state
-  // with the fewest fold-overs, are tried; a result with fewer fold-overs (equal: lower final
-  // E) is taken.
-  // \p later: another earlier state follows this one.
-  auto try_earlier = [&](std::unique_ptr<State>& earlier, bool& flag, bool later) {
-    if (result.foldovers_final == 0 || !earlier) return;
-    check_cancel(observer);
-    NodeOptResult alt;
-    if (speculative.valid() && earlier == pre_polish) {
-      Speculative done = speculative.get();
-      if (done.error) std::rethrow_exception(done.error);
-      alt = std::move(done.result);
-      ++counters.parallel_fallbacks;
-      if (observer)  // streamed now, in the order of the sequential attempt
-        for (const StepReport& r : alt.reports) observer->on_step(r);
-    } else {
-      Evaluation ev = evaluate_fresh(earlier->mesh, earlier->layout, options, false);
-      finish(*earlier, ev, alt, later, observer);
-    }
-    ++counters.fresh_pipelines;
-    result.reports.insert(result.reports.end(), alt.reports.begin(), alt.reports.end());
-    if (alt.foldovers_final < result.foldovers_final ||
-        (alt.foldovers_final == result.foldovers_final && alt.E_final < result.E_final)) {
-      state = std::move(*earlier);
-      result.pipeline = alt.pipeline;
-      result.descent_pipeline = alt.descent_pipeline;
-      result.E_descent = alt.E_descent;
-      result.foldovers_descent = alt.foldovers_descent;
-      result.E_final = alt.E_final;
-      result.foldovers_final = alt.foldovers_final;
-      result.orientation_constraints = alt.orientation_constraints;
-      result.orientation_options = alt.orientation_options;
-      result.orientation = alt.orientation;
-      result.face_weights = alt.face_weights;
-      result.stiffening_iterations = alt.stiffening_iterations;
-      flag = true;
-    }
-    earlier.reset();
-  };
-  if (!no.orientation_at_end && !no.stiffen_at_end) pre_polish.reset(), fewest_folds.reset();
-  try_earlier(pre_polish, result.polish_reverted, try_fewest);
-  if (try_fewest) try_earlier(fewest_folds, result.fewest_foldovers_reverted, false);
-  if (has_earlier && no.stiffen_at_end && result.foldovers_final > 0)
-    stiffen_into(state, result.descent_pipeline, result);
-  if (stats) *stats = counters;
-  result.mesh = std::move(state.mesh);
-  result.layout = std::move(state.layout);
-  result.time_s = seconds_since(t_start);
-  return result;
+};
+
+NodeOptimizer::NodeOptimizer(const TriMesh& mesh, const Layout& layout,
+                             const PipelineOptions& options, const NodeOptOptions& node_options,
+                             Observer* observer, std::shared_ptr<Pipeline> start)
+    : impl_(std::make_unique<Impl>(mesh, layout, options, node_options, observer,
+                                   std::move(start))) {}
+
+NodeOptimizer::~NodeOptimizer() = default;
+
+bool NodeOptimizer::step(Observer* observer) {
+  if (impl_->finished) throw std::logic_error("NodeOptimizer::step after finish");
+  impl_->observer = observer;
+  return impl_->step();
+}
+
+void NodeOptimizer::set_pinned(const std::vector<char>& pinned) {
+  if (impl_->finished) throw std::logic_error("NodeOptimizer::set_pinned after finish");
+  if (pinned.size() != impl_->state.layout.nodes.size())
+    throw std::invalid_argument("NodeOptimizer::set_pinned: one flag per layout node expected");
+  impl_->set_pinned(pinned);
+}
+
+const TriMesh& NodeOptimizer::mesh() const {
+  return impl_->state.mesh;
+}
+
+const Layout& NodeOptimizer::layout() const {
+  return impl_->state.layout;
+}
+
+double NodeOptimizer::energy() const {
+  return impl_->current.E;
+}
+
+int NodeOptimizer::foldovers() const {
+  return impl_->current.foldovers;
+}
+
+const std::vector<StepReport>& NodeOptimizer::reports() const {
+  return impl_->result.reports;
+}
+
+bool NodeOptimizer::done() const {
+  return impl_->descent_over;
+}
+
+std::shared_ptr<Pipeline> NodeOptimizer::pipeline(Observer* observer) {
+  if (impl_->finished) throw std::logic_error("NodeOptimizer::pipeline after finish");
+  impl_->observer = observer;
+  impl_->solve_current();
+  return impl_->current.pipeline;
+}
+
+NodeOptResult NodeOptimizer::finish(Observer* observer, NodeOptStats* stats) {
+  if (impl_->finished) throw std::logic_error("NodeOptimizer::finish called twice");
+  impl_->observer = observer;
+  return impl_->finish(stats);
+}
+
+NodeOptResult optimize_nodes(const TriMesh& mesh, const Layout& layout,
+                             const PipelineOptions& options, const NodeOptOptions& node_options,
+                             Observer* observer, std::shared_ptr<Pipeline> start,
+                             NodeOptStats* stats) {
+  NodeOptimizer optimizer(mesh, layout, options, node_options, observer, std::move(start));
+  while (optimizer.step(observer)) {
+  }
+  return optimizer.finish(observer, stats);
 }
 
 }  // namespace qs

@@ -194,6 +194,51 @@ struct NodeOptStats {
 //! boundary or a feature edge (v1: such nodes stay). Indices into layout.nodes.
 std::vector<int> movable_nodes(const TriMesh& mesh, const Layout& layout);
 
+//! The node optimization one unit at a time, for callers that show every state (the editor):
+//! the same units, in the same order, with the same results as optimize_nodes, which runs
+//! `while (step()) {}` and then finish(). A unit is a descent step or a hop sweep
+//! (NodeOptOptions::hop_polish); each is reported to the observer given to that call.
+//! Not thread-safe: one thread drives it (it may start its own second threads).
+class NodeOptimizer {
+ public:
+  //! The initial solve (or \p start, as for optimize_nodes), reported to \p observer. The
+  //! input mesh's positions are the "original" positions for the whole optimization.
+  //! \throw as optimize_nodes.
+  NodeOptimizer(const TriMesh& mesh, const Layout& layout, const PipelineOptions& options,
+                const NodeOptOptions& node_options = {}, Observer* observer = nullptr,
+                std::shared_ptr<Pipeline> start = nullptr);
+  ~NodeOptimizer();
+  NodeOptimizer(const NodeOptimizer&) = delete;
+  NodeOptimizer& operator=(const NodeOptimizer&) = delete;
+
+  //! Runs the next unit. False when the descent and the polish are over (a last hop sweep that
+  //! kept nothing may have run in this call): call finish(). \throw Cancelled, SolverError.
+  bool step(Observer* observer = nullptr);
+  //! Pins (one flag per layout node, by index) for the next steps: a pinned node does not move
+  //! from now on, a released one may. An earlier state kept for the fold-over removal in which
+  //! a newly pinned node stands elsewhere is dropped.
+  void set_pinned(const std::vector<char>& pinned);
+
+  //! The current (last accepted) state.
+  const TriMesh& mesh() const;
+  const Layout& layout() const;
+  double energy() const;  //!< E of the current state (unweighted, length²)
+  int foldovers() const;  //!< of the current state's parameterization
+  //! Every report so far (the initial solve first).
+  const std::vector<StepReport>& reports() const;
+  bool done() const;  //!< step() returned false
+  //! The Pipeline solved at the current state (solved again when the last trial, rejected,
+  //! re-solved it in place). Valid until the next step(); do not solve it yourself.
+  std::shared_ptr<Pipeline> pipeline(Observer* observer = nullptr);
+  //! Fold-over removal at the current state (and the fallbacks) and the result; ends the
+  //! optimization (no step() or pipeline() after it).
+  NodeOptResult finish(Observer* observer = nullptr, NodeOptStats* stats = nullptr);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 //! Runs the node optimization. The input mesh's positions are the "original" positions (each
 //! relocated vertex lies on the original surface; a vertex given up by a node gets its original
 //! position back). Every step is reported to \p observer, which is polled between solves.
