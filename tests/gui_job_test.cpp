@@ -2,7 +2,9 @@
 // timings and node positions per step, the quad mesh at the final step, and the exports.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include "app/gui/history.h"
@@ -117,6 +119,100 @@ TEST(GuiJob, DisplayedStepMatchesFreshSolve) {
   EXPECT_TRUE(std::abs(s->energy - E) <= 1e-9 * E || std::abs(s->energy - E_oriented) <= 1e-9 * E)
       << "displayed " << s->energy << ", fresh " << E << ", fresh oriented " << E_oriented;
   ASSERT_EQ(s->exports->corner_uv.size(), fresh.parameterization()->corner_uv.size());
+}
+
+// A run with the default settings ends where `quadsketch-cli optimize` ends (without
+// stiffening, which the editor leaves out): the same units (descent steps, hop sweeps,
+// fold-over removal), so the same final mesh and node vertices, below the descent alone.
+TEST(GuiJob, RunEndsWhereTheOptimizerEnds) {
+  const Example ex = example();
+  WorkerOptions options;
+  options.publish_interval_ms = 0;
+  const auto s = test::run_job(ex, options);
+  ASSERT_EQ(s->status, WorkerStatus::Finished) << s->message;
+  ASSERT_TRUE(s->exports);
+  ASSERT_LT(s->iteration, options.max_steps);  // ended by itself
+  EXPECT_EQ(int(s->node_history.size()), s->iteration);
+
+  qs::PipelineOptions po;  // as the job sets them from WorkerOptions
+  po.field.constraints.curvature = options.align;
+  po.field.constraints.sharp_angle_deg = options.sharp_angle_deg;
+  po.param.anisotropy = options.anisotropy;
+  NodeOptOptions no;
+  no.max_steps = options.descent_steps;
+  no.alpha = options.alpha;
+  no.stiffen_at_end = false;
+  const NodeOptResult r = optimize_nodes(*ex.mesh, ex.layout, po, no);
+  ASSERT_GT(r.hop_rounds, 0);
+  const TriMesh& m = s->exports->mesh;
+  ASSERT_EQ(m.n_vertices(), r.mesh.n_vertices());
+  int moved_differently = 0;
+  for (auto v : m.vertices()) moved_differently += m.point(v) != r.mesh.point(v);
+  EXPECT_EQ(moved_differently, 0);
+  ASSERT_EQ(s->exports->layout.nodes.size(), r.layout.nodes.size());
+  for (size_t n = 0; n < r.layout.nodes.size(); ++n)
+    EXPECT_EQ(s->exports->layout.nodes[n].vertex, r.layout.nodes[n].vertex) << "node " << n;
+  EXPECT_NEAR(s->metrics.E, r.E_final, 1e-9 * r.E_final);
+  EXPECT_EQ(s->metrics.foldovers, r.foldovers_final);
+
+  NodeOptOptions descent = no;
+  descent.hop_polish = false;
+  const NodeOptResult d = optimize_nodes(*ex.mesh, ex.layout, po, descent);
+  std::printf("[stat] editor run: %d steps, E %.6g (descent alone %.6g)\n", s->iteration,
+              s->metrics.E, d.E_final);
+  EXPECT_LT(s->metrics.E, d.E_final * 0.99);
+}
+
+// A node pinned between steps keeps its position for the rest of the run (the fold-over
+// removal included), while the others go on moving.
+TEST(GuiJob, NodePinnedMidRunStaysPut) {
+  using namespace std::chrono_literals;
+  const Example ex = example();
+  WorkerOptions options;
+  options.publish_interval_ms = 0;
+  Worker worker(pipeline_step);
+  worker.send(cmd::SetOptions{options});
+  worker.send(cmd::LoadMesh{ex.mesh, ex.layout});
+  worker.send(cmd::Step{3});  // the initial solve and two descent steps
+  auto s = worker.wait_for(
+      [](const Snapshot& x) { return x.iteration >= 3 && x.status != WorkerStatus::Running; }, 60s);
+  ASSERT_EQ(s->iteration, 3) << s->message;
+  ASSERT_TRUE(s->layout && s->exports);
+  const LayoutNode& node = s->layout->nodes[0];
+  const int id = node.id, vertex = node.vertex;
+  const auto position = s->exports->mesh.point(s->exports->mesh.vertex_handle(vertex));
+  const auto frame_position = [&](const NodeFrame& f) {
+    for (size_t k = 0; k < f.ids.size(); ++k)
+      if (f.ids[k] == id) return f.positions[k];
+    ADD_FAILURE() << "node " << id << " missing in a frame";
+    return std::array<float, 3>{};
+  };
+  const std::array<float, 3> pinned_at = frame_position(*s->node_history.back());
+  worker.send(cmd::SetPin{id, vertex});
+  worker.send(cmd::Run{});
+  s = worker.wait_for(
+      [](const Snapshot& x) {
+        return x.status == WorkerStatus::Finished || x.status == WorkerStatus::Failed;
+      },
+      120s);
+  ASSERT_EQ(s->status, WorkerStatus::Finished) << s->message;
+  ASSERT_GT(s->iteration, 5);
+  for (size_t k = 3; k < s->node_history.size(); ++k)
+    EXPECT_EQ(frame_position(*s->node_history[k]), pinned_at) << "frame " << k;
+  // The others moved after the pin.
+  const NodeFrame& before = *s->node_history[2];
+  const NodeFrame& after = *s->node_history.back();
+  int others_moved = 0;
+  for (size_t k = 0; k < after.ids.size(); ++k)
+    others_moved += after.ids[k] != id && after.positions[k] != before.positions[k];
+  EXPECT_GT(others_moved, 0);
+  const Layout& out = s->exports->layout;
+  const auto it = std::find_if(out.nodes.begin(), out.nodes.end(),
+                               [&](const LayoutNode& n) { return n.id == id; });
+  ASSERT_NE(it, out.nodes.end());
+  EXPECT_EQ(it->vertex, vertex);
+  EXPECT_TRUE(it->pinned);
+  EXPECT_EQ(s->exports->mesh.point(s->exports->mesh.vertex_handle(vertex)), position);
 }
 
 }  // namespace qs::app

@@ -394,9 +394,16 @@ void App::draw_pipeline_options() {
     ImGui::SetTooltip("How much more misalignment costs than scale in energy (1) (1: isotropic)");
   ImGui::Checkbox("Node optimization", &o.node_optimization);
   if (!o.node_optimization) ImGui::BeginDisabled();
-  ImGui::SliderInt("Max steps", &o.max_steps, 1, 200, "%d", ImGuiSliderFlags_Logarithmic);
+  ImGui::SliderInt("Descent steps", &o.descent_steps, 0, 200, "%d", ImGuiSliderFlags_Logarithmic);
   if (ImGui::IsItemHovered())
-    ImGui::SetTooltip("Steps of a run, the initial solve included (--steps)");
+    ImGui::SetTooltip(
+        "Gradient steps before the first hop sweep; each sweep that moves nodes allows more "
+        "(--steps)");
+  ImGui::SliderInt("Max steps", &o.max_steps, 1, 1000, "%d", ImGuiSliderFlags_Logarithmic);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip(
+        "Steps of a run at most: the initial solve, descent steps and hop sweeps; the last one "
+        "also removes fold-overs");
   float alpha = float(o.alpha);
   if (ImGui::SliderFloat("alpha (damping)", &alpha, 0.05f, 1.0f, "%.2f")) o.alpha = alpha;
   if (ImGui::IsItemHovered())
@@ -407,6 +414,7 @@ void App::draw_pipeline_options() {
   o.sharp_angle_deg = std::clamp(o.sharp_angle_deg, 1.0, 180.0);
   o.anisotropy = std::clamp(o.anisotropy, 1.0, 1000.0);
   o.max_steps = std::clamp(o.max_steps, 1, 10000);
+  o.descent_steps = std::clamp(o.descent_steps, 0, 10000);
   o.alpha = std::clamp(o.alpha, 0.01, 1.0);
   if (ImGui::Button("Defaults")) {
     const WorkerOptions defaults;
@@ -415,6 +423,7 @@ void App::draw_pipeline_options() {
     o.anisotropy = defaults.anisotropy;
     o.node_optimization = defaults.node_optimization;
     o.max_steps = defaults.max_steps;
+    o.descent_steps = defaults.descent_steps;
     o.alpha = defaults.alpha;
   }
   ImGui::SameLine();

@@ -32,20 +32,19 @@ class CancelForwarder : public Observer {
 };
 
 struct JobState {
-  TriMesh mesh;             // current geometry (node relocation moves vertices on the surface)
-  Layout layout;            // current layout (node vertices, re-routed arcs)
-  PipelineOptions options;  // fixed when the job starts (WorkerOptions of that moment)
+  TriMesh mesh;                 // current geometry (node relocation moves vertices on the surface)
+  Layout layout;                // current layout (node vertices, re-routed arcs)
+  PipelineOptions options;      // fixed when the job starts (WorkerOptions of that moment)
+  NodeOptOptions node_options;  // fixed when the job starts
   std::set<int> pinned_in_layout;  // nodes pinned in the editor's layout (stay pinned)
-  double alpha = 0.75;
-  int halvings = 0;
   double energy = 0;
-  bool done = false;
-  //! Solved (field + parameterization with `options`) at exactly (mesh, layout), or null: the
-  //! display reuses it and the next node-optimization step starts from it (no re-solve).
+  StepMetrics metrics;  // of the last displayed state (repeated for rejected steps)
+  //! Solved (field + parameterization) at exactly (mesh, layout), or null: the display reuses
+  //! it (no re-solve); the initial one is the node optimizer's start.
   std::shared_ptr<Pipeline> pipeline;
-  //! Solved with exactly `options` at (mesh, layout) (`pipeline` may hold the optimizer's
-  //! orientation-constrained solve instead): the next step's initial solve.
-  std::shared_ptr<Pipeline> warm;
+  //! The node optimization, created at the first step after the initial solve: the same units
+  //! as `quadsketch-cli optimize` (descent steps, hop sweeps, fold-over removal at the end).
+  std::unique_ptr<NodeOptimizer> optimizer;
 };
 
 // Node positions of \p layout on \p mesh: the traced position when known, else the vertex.
@@ -187,12 +186,24 @@ StepResult solve_for_display(JobState& job, WorkerState& state, const WorkerObse
   return result;
 }
 
-// Applies the UI's pins (node id -> vertex) to the job's layout: pinned nodes stay where they
-// are (the UI pins a node at its current vertex); a cleared pin releases the node unless the
+// The UI's pins (node id -> vertex) per node of \p layout: pinned nodes stay where they are
+// (the UI pins a node at its current vertex); a cleared pin releases the node unless the
 // editor's layout pinned it.
-void apply_pins(const WorkerState& state, const JobState& job, Layout& layout) {
-  for (auto& node : layout.nodes)
-    node.pinned = job.pinned_in_layout.count(node.id) > 0 || state.pins.count(node.id) > 0;
+std::vector<char> pin_flags(const WorkerState& state, const JobState& job, const Layout& layout) {
+  std::vector<char> flags;
+  for (const auto& node : layout.nodes)
+    flags.push_back(job.pinned_in_layout.count(node.id) > 0 || state.pins.count(node.id) > 0);
+  return flags;
+}
+
+// The editor's node optimization: `quadsketch-cli optimize` with the job's settings, except that
+// stiffening is left out (the display shows the solve without its face weights).
+NodeOptOptions editor_node_options(const WorkerOptions& o) {
+  NodeOptOptions no;
+  no.max_steps = o.descent_steps;
+  no.alpha = o.alpha;
+  no.stiffen_at_end = false;
+  return no;
 }
 
 }  // namespace
@@ -205,55 +216,81 @@ StepResult pipeline_step(WorkerState& state, const WorkerObserver& observer) {
     job->mesh = *state.mesh;
     job->layout = state.layout;
     job->options = pipeline_options(state.options);
-    job->alpha = state.options.alpha;
+    job->node_options = editor_node_options(state.options);
     for (const auto& node : job->layout.nodes)
       if (node.pinned) job->pinned_in_layout.insert(node.id);
     state.user = job;
     const bool last = !state.options.node_optimization || state.options.max_steps <= 1;
     StepResult result = solve_for_display(*job, state, observer, last);
+    job->metrics = result.metrics;
     result.finished = !state.options.node_optimization;
     result.message = "initial solve: " + result.message;
     result.metrics.total_ms = ms_since(start);
     return result;
   }
-  // One descent step of node optimization from the current state.
-  apply_pins(state, *job, job->layout);
+  // The next unit of node optimization (a descent step or a hop sweep) from the current state;
+  // the fold-over removal when the optimization ends or the run's last step has come.
   CancelForwarder cancel(observer);
-  NodeOptOptions options;
-  options.max_steps = 1;
-  options.hop_polish = false;  // one step per call (a hop sweep would add more steps)
-  options.alpha = job->alpha;
-  options.stiffen_at_end = false;
   auto t = Clock::now();
-  // Warm start from the Pipeline of the previous display (optimize_nodes ignores it when the
-  // pins changed the layout), and display the Pipeline it returns: one solve per trial only.
-  // The optimizer may re-solve the start in place, so the job drops it until the step is done.
-  std::shared_ptr<Pipeline> warm_start = job->warm ? job->warm : job->pipeline;
-  job->pipeline.reset();
-  job->warm.reset();
-  const NodeOptResult step =
-      optimize_nodes(job->mesh, job->layout, job->options, options, &cancel, std::move(warm_start));
-  const double nodeopt_ms = ms_since(t);
-  const bool accepted = step.accepted > 0;
-  job->pipeline = step.pipeline;
-  job->warm = step.descent_pipeline;
-  if (accepted) {
-    job->mesh = step.mesh;
-    job->layout = step.layout;
-  } else {
-    job->alpha *= 0.5;
-    ++job->halvings;
+  if (!job->optimizer) {
+    std::shared_ptr<Pipeline> start_pipeline = std::move(job->pipeline);  // solved in place later
+    job->optimizer = std::make_unique<NodeOptimizer>(job->mesh, job->layout, job->options,
+                                                     job->node_options, &cancel, start_pipeline);
   }
-  const bool finished = job->halvings > options.max_halvings;
-  const bool last = finished || state.iteration + 1 >= state.options.max_steps;
-  StepResult result = solve_for_display(*job, state, observer, last);
-  result.metrics.nodeopt_ms = nodeopt_ms;
+  NodeOptimizer& optimizer = *job->optimizer;
+  optimizer.set_pinned(pin_flags(state, *job, optimizer.layout()));
+  const size_t reports_before = optimizer.reports().size();
+  const bool more = optimizer.step(&cancel);
+  const bool last = !more || state.iteration + 1 >= state.options.max_steps;
+  bool changed = false;  // a unit of this call kept a new state
+  std::ostringstream what;
+  for (size_t k = reports_before; k < optimizer.reports().size(); ++k) {
+    const StepReport& r = optimizer.reports()[k];
+    changed |= r.accepted;
+    what << (k > reports_before ? "; " : "") << r.phase << " step " << r.step
+         << (r.accepted             ? " accepted"
+             : r.phase == "descent" ? " rejected (step size halved)"
+                                    : " kept nothing");
+  }
+  std::string prefix = what.str();
+  StepResult result;
+  if (last) {  // fold-over removal (and the earlier states it falls back to)
+    NodeOptResult end = optimizer.finish(&cancel);
+    job->optimizer.reset();
+    job->mesh = std::move(end.mesh);
+    job->layout = std::move(end.layout);
+    job->pipeline = std::move(end.pipeline);
+    if (end.orientation.ran)
+      prefix += std::string(prefix.empty() ? "" : "; ") + "fold-overs " +
+                std::to_string(end.foldovers_descent) + " -> " +
+                std::to_string(end.foldovers_final) + " by orientation constraints";
+    const double nodeopt_ms = ms_since(t);
+    result = solve_for_display(*job, state, observer, true);
+    result.metrics.nodeopt_ms = nodeopt_ms;
+    result.finished = true;
+  } else if (changed) {
+    job->mesh = optimizer.mesh();
+    job->layout = optimizer.layout();
+    job->pipeline = optimizer.pipeline(&cancel);
+    const double nodeopt_ms = ms_since(t);
+    result = solve_for_display(*job, state, observer, false);
+    result.metrics.nodeopt_ms = nodeopt_ms;
+  } else {  // nothing kept: the display stays (no solve), the energy and metrics repeat
+    result.energy = job->energy;
+    result.metrics = job->metrics;
+    result.metrics.nodeopt_ms = ms_since(t);
+    result.nodes = node_frame(job->mesh, state.layout);
+    result.validate = false;
+  }
+  job->metrics = result.metrics;
   result.metrics.total_ms = ms_since(start);
+  // Pins shown on the traced layout: the ones in force.
+  const std::vector<char> pins = pin_flags(state, *job, state.layout);
+  for (size_t n = 0; n < state.layout.nodes.size(); ++n) state.layout.nodes[n].pinned = pins[n];
   std::ostringstream ss;
-  ss << "step " << state.iteration << (accepted ? " accepted" : " rejected (step size halved)")
-     << ": " << result.message;
+  ss << prefix;
+  if (!result.message.empty()) ss << ": " << result.message;
   result.message = ss.str();
-  result.finished = finished;
   return result;
 }
 

@@ -30,7 +30,10 @@ namespace qs {
 
 //! Options of a job; changed with SetOptions, read by the step function at its next step.
 struct WorkerOptions {
-  int max_steps = 25;               //!< the job finishes after this many steps
+  //! The job finishes after this many steps at most (the editor's job: the initial solve, then
+  //! one step per descent step or hop sweep of node optimization; its last step also removes
+  //! fold-overs).
+  int max_steps = 200;
   double publish_interval_ms = 16;  //!< minimum time between intermediate snapshots
   bool node_optimization = true;
   double quad_size = 0.0;  //!< 0: automatic
@@ -39,6 +42,7 @@ struct WorkerOptions {
   double sharp_angle_deg = 35.0;  //!< sharp feature dihedral angle (--sharp-angle)
   double anisotropy = 10.0;       //!< anisotropic norm factor of the parameterization energy
   double alpha = 0.75;            //!< initial damping α of node-optimization steps
+  int descent_steps = 25;         //!< descent steps before the first hop sweep (--steps)
 };
 
 //! What a step function sees of the job: a qs::Observer, so it can be handed straight to
