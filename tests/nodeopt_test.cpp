@@ -834,7 +834,7 @@ TEST(NodeOptimizer, ReuseMatchesFreshPipelines) {
 }
 
 // The same on the bundled example (curvature-aligned field with constraint clusters), one
-// step at a time with the warm start, as the editor runs it.
+// step at a time with the warm start (each call continues the previous Pipeline).
 TEST(NodeOptimizer, ReuseMatchesFreshPipelinesOnExample) {
   const std::string dir = std::string(QS_ASSETS_DIR) + "/example/";
   TriMesh mesh = load_mesh(dir + "ellipsoid.obj");

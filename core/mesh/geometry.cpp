@@ -101,8 +101,99 @@ void compute_totals(const TriMesh& mesh, GeometryCache& g) {
   g.mean_edge_length = g.n_edges ? length_sum / g.n_edges : 0.0;
 }
 
+// Transport residual of interior vertex v: Σ σ·κ over its edges (σ = +1 when the loop around
+// v, counter-clockwise, crosses the edge from face i to face j, i.e. v is the edge's second
+// vertex) minus the angle defect. A multiple of 2π; constant while κ is continued correctly.
+double transport_residual(const GeometryCache& g, int v) {
+  double h = 0;
+  for (int i = g.vertex_face_offset[v]; i < g.vertex_face_offset[v + 1]; ++i) {
+    const int f = g.vertex_faces[i];
+    for (int e : g.face_edges[f]) {
+      if (g.edge_face_i[e] != f) continue;  // each edge once (from its face i)
+      const auto& ev = g.edge_vertices[e];
+      if (ev[1] == v)
+        h += g.kappa[e];
+      else if (ev[0] == v)
+        h -= g.kappa[e];
+    }
+  }
+  return h - g.angle_defect[v];
+}
+
+// After κ was continued on some edges (old values \p old_kappa, per edge, NaN where κ was not
+// recomputed): a single update in which an edge's frames turn by more than π against each
+// other (a vertex relocated far within its 1-ring, next to a short edge) makes the continuation
+// take the wrong branch, κ off by 2π, and with the period jumps unchanged two vertices gain
+// index ±4 (spurious singularities, fold-overs: seen on the bundled example after a hop).
+// Each interior vertex's transport residual (\p residual_before, for \p vertices) must stay
+// the same; an edge between two vertices whose residuals moved by +2π and −2π is turned back
+// by 2π (the one whose κ moved most first).
+void restore_transport(GeometryCache& g, const std::vector<int>& vertices,
+                       const std::vector<double>& residual_before,
+                       const std::vector<double>& old_kappa) {
+  std::vector<int> off;  // vertices whose residual moved
+  std::vector<int> turns(g.n_vertices, 0);
+  for (size_t k = 0; k < vertices.size(); ++k) {
+    const int v = vertices[k];
+    const int m =
+        static_cast<int>(std::lround((transport_residual(g, v) - residual_before[k]) / (2 * M_PI)));
+    if (m != 0) turns[v] = m, off.push_back(v);
+  }
+  for (bool progress = !off.empty(); progress;) {
+    progress = false;
+    for (int v : off) {
+      if (turns[v] == 0) continue;
+      const int sign = turns[v] > 0 ? 1 : -1;
+      // Candidates: edges of v to a vertex whose residual moved the other way.
+      int best = -1;
+      double best_change = -1;
+      for (int i = g.vertex_face_offset[v]; i < g.vertex_face_offset[v + 1]; ++i) {
+        const int f = g.vertex_faces[i];
+        for (int e : g.face_edges[f]) {
+          if (g.edge_face_i[e] != f || std::isnan(old_kappa[e])) continue;
+          const auto& ev = g.edge_vertices[e];
+          if (ev[0] != v && ev[1] != v) continue;
+          const int u = ev[0] == v ? ev[1] : ev[0];
+          if (turns[u] * sign >= 0) continue;
+          const double change = std::abs(g.kappa[e] - old_kappa[e]);
+          if (change > best_change) best_change = change, best = e;
+        }
+      }
+      if (best < 0) continue;
+      const auto& ev = g.edge_vertices[best];
+      const int u = ev[0] == v ? ev[1] : ev[0];
+      const double s = ev[1] == v ? 1.0 : -1.0;  // σ of v on this edge
+      g.kappa[best] -= 2 * M_PI * s * sign;      // v's residual −2π·sign, u's +2π·sign
+      turns[v] -= sign;
+      turns[u] += sign;
+      progress = true;
+    }
+  }
+}
+
+// The interior vertices of \p faces and their transport residuals (restore_transport).
+void residuals_of(const GeometryCache& g, const std::vector<int>& faces, std::vector<int>& vertices,
+                  std::vector<double>& residuals) {
+  std::vector<char> seen(g.n_vertices, 0);
+  for (int f : faces)
+    for (int v : g.face_vertices[f])
+      if (!seen[v] && !g.vertex_on_boundary[v]) {
+        seen[v] = 1;
+        vertices.push_back(v);
+        residuals.push_back(transport_residual(g, v));
+      }
+}
+
 void compute_geometry(const TriMesh& mesh, GeometryCache& g, bool continue_kappa) {
   const int nf = g.n_faces;
+  std::vector<int> residual_vertices;
+  std::vector<double> residuals;
+  if (continue_kappa && static_cast<int>(g.kappa.size()) == g.n_edges &&
+      static_cast<int>(g.angle_defect.size()) == g.n_vertices) {
+    std::vector<int> all(nf);
+    for (int f = 0; f < nf; ++f) all[f] = f;
+    residuals_of(g, all, residual_vertices, residuals);
+  }
   g.face_normal.resize(nf);
   g.face_frame.resize(nf);
   g.face_area.resize(nf);
@@ -120,6 +211,8 @@ void compute_geometry(const TriMesh& mesh, GeometryCache& g, bool continue_kappa
   g.kappa.assign(g.n_edges, 0.0);
   g.edge_length.assign(g.n_edges, 0.0);
   for (int e = 0; e < g.n_edges; ++e) compute_edge(mesh, g, e, continue_kappa ? &old[e] : nullptr);
+  if (continue_kappa && !residual_vertices.empty())
+    restore_transport(g, residual_vertices, residuals, old);
   compute_totals(mesh, g);
   g.positions.resize(g.n_vertices);
   for (auto v : mesh.vertices()) g.positions[v.idx()] = mesh.point(v);
@@ -195,14 +288,20 @@ void update_geometry(const TriMesh& mesh, GeometryCache& g) {
       const int f = g.vertex_faces[i];
       if (!seen_face[f]) seen_face[f] = 1, faces.push_back(f);
     }
+  std::vector<int> residual_vertices;
+  std::vector<double> residuals;
+  residuals_of(g, faces, residual_vertices, residuals);
   for (int f : faces) compute_face(mesh, g, f);
   std::vector<char> seen_vertex(g.n_vertices, 0), seen_edge(g.n_edges, 0);
+  std::vector<double> old_kappa(g.n_edges, std::nan(""));
   for (int f : faces) {
     for (int v : g.face_vertices[f])
       if (!seen_vertex[v]) seen_vertex[v] = 1, compute_defect(g, v);
     for (int e : g.face_edges[f])
-      if (!seen_edge[e]) seen_edge[e] = 1, compute_edge(mesh, g, e, &g.kappa[e]);
+      if (!seen_edge[e])
+        seen_edge[e] = 1, old_kappa[e] = g.kappa[e], compute_edge(mesh, g, e, &g.kappa[e]);
   }
+  restore_transport(g, residual_vertices, residuals, old_kappa);
   compute_totals(mesh, g);
   for (int v : moved) g.positions[v] = mesh.point(mesh.vertex_handle(v));
 }
