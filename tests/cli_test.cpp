@@ -222,5 +222,53 @@ TEST(Cli, OptimizeMovesTheSketchedNodesAndRemovesFoldovers) {
   }
 }
 
+// Sliding along the boundary from the command line: a boundary node of a flat grid layout two
+// edges off its place slides back by default (report: sliding_nodes), stays with --no-sliding;
+// --keep-sharp-edges is accepted (the flat grid has no sharp edges: the same result).
+TEST(Cli, OptimizeSlidesBoundaryNodes) {
+  const auto grid = test::disk_grid(8, 8, 2, 2);
+  Layout layout = grid.layout;
+  int node = -1;
+  for (int n = 0; n < static_cast<int>(layout.nodes.size()); ++n)
+    if (layout.nodes[n].vertex == 4) node = n;  // grid point (4, 0)
+  ASSERT_GE(node, 0);
+  // The node two edges along the boundary, its arcs along the boundary following it.
+  LayoutArc* right = nullptr;
+  LayoutArc* left = nullptr;
+  for (auto& arc : layout.arcs) {
+    if (arc.from == layout.nodes[node].id && arc.path[1] == 5) right = &arc;
+    if (arc.to == layout.nodes[node].id && arc.path[arc.path.size() - 2] == 3) left = &arc;
+  }
+  ASSERT_TRUE(right && left);
+  right->path.erase(right->path.begin(), right->path.begin() + 2);  // from (6, 0) on
+  left->path.push_back(5);
+  left->path.push_back(6);
+  layout.nodes[node].vertex = 6;
+  for (auto& arc : layout.arcs)  // the arc into the grid starts at (6, 0), then goes up
+    if (arc.from == layout.nodes[node].id && arc.path[1] == 13)
+      arc.path = {6, 15, 14, 13, 22, 31, 40};
+  ASSERT_TRUE(validate_layout(grid.mesh, layout).valid());
+  const std::string dir = test::temp_dir("cli_slide");
+  test::write_obj(grid.mesh, dir + "/mesh.obj");
+  save_layout(layout, dir + "/layout.json", &grid.mesh);
+  auto run = [&](const std::string& flags, const std::string& out) {
+    std::string output;
+    EXPECT_EQ(test::run_command(cli("optimize --quiet --mesh " + dir + "/mesh.obj --layout " + dir +
+                                    "/layout.json --out " + dir + "/" + out + " " + flags),
+                                &output),
+              0)
+        << output;
+    return read_json(dir + "/" + out + "/report.json");
+  };
+  const auto slide = run("", "slide"), keep = run("--keep-sharp-edges", "keep"),
+             stay = run("--no-sliding", "stay");
+  EXPECT_GT(slide["node_optimization"]["sliding_nodes"].get<int>(), 0);
+  EXPECT_EQ(stay["node_optimization"]["sliding_nodes"].get<int>(), 0);
+  EXPECT_LT(slide["E_final"].get<double>(), 1e-6 * slide["E_init"].get<double>());
+  EXPECT_GT(stay["E_final"].get<double>(), 0.05 * stay["E_init"].get<double>());
+  EXPECT_EQ(keep["E_final"].get<double>(), slide["E_final"].get<double>());
+  EXPECT_TRUE(slide["structurally_equivalent"].get<bool>());
+}
+
 }  // namespace
 }  // namespace qs

@@ -67,6 +67,14 @@ int main(int argc, char** argv) {
   cmd_opt->add_flag("--no-align", opt.no_align, "Ignore curvature directions (baseline)");
   cmd_opt->add_flag("--discrete-relocation", opt.discrete_relocation,
                     "Move nodes vertex by vertex (baseline)");
+  cmd_opt->add_flag("--no-sliding", opt.no_sliding,
+                    "Nodes on the boundary and on feature curves stay instead of sliding along "
+                    "them; nodes on sharp edges move freely and vertices on sharp edges may be "
+                    "relocated (sharp edges not kept)");
+  cmd_opt->add_flag("--keep-sharp-edges", opt.keep_sharp_edges,
+                    "Treat the sharp edges (--sharp-angle) as feature curves in the node "
+                    "optimization: nodes on them slide along them and their vertices keep their "
+                    "place (sharp edges keep their shape; higher E)");
   cmd_opt->add_flag("--no-orientation", opt.no_orientation,
                     "No orientation constraints against fold-overs after the node optimization "
                     "(stiffening only)");

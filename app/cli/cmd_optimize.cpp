@@ -77,6 +77,8 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       no.max_steps = o.steps;
       no.gradient = o.gradient == "exact" ? GradientMethod::Exact : GradientMethod::Estimator;
       no.orientation_at_end = !o.no_orientation;
+      no.slide_on_curves = !o.no_sliding;
+      no.sharp_edges_as_curves = o.keep_sharp_edges;
       // Integer sizes put nodes exactly on shared iso-lines: fresh trial Pipelines there (see
       // NodeOptOptions::reuse_field).
       if (o.integer) no.reuse_field = false;
@@ -177,6 +179,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
           {"steps", node_result->steps},
           {"accepted", node_result->accepted},
           {"halvings", node_result->halvings},
+          {"sliding_nodes", node_result->sliding_nodes},
           {"foldovers_init", node_result->foldovers_init},
           {"foldovers_descent", node_result->foldovers_descent},
           {"E_descent", node_result->E_descent},

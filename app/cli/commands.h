@@ -30,7 +30,9 @@ struct OptimizeOptions {
   std::string gradient = "estimator";
   bool no_align = false;
   bool discrete_relocation = false;
-  bool no_orientation = false;  //!< no orientation constraints after the node optimization
+  bool no_orientation = false;    //!< no orientation constraints after the node optimization
+  bool no_sliding = false;        //!< nodes on curves stay (NodeOptOptions::slide_on_curves off)
+  bool keep_sharp_edges = false;  //!< NodeOptOptions::sharp_edges_as_curves
   //! Curl-reducing sizing field (ParamOptions::sizing); unset: the library default.
   std::optional<bool> sizing;
   double sharp_angle_deg = 35.0;

@@ -404,6 +404,11 @@ void App::draw_pipeline_options() {
     ImGui::SetTooltip(
         "Steps of a run at most: the initial solve, descent steps and hop sweeps; the last one "
         "also removes fold-overs");
+  ImGui::Checkbox("Keep sharp edges", &o.keep_sharp_edges);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip(
+        "Nodes on sharp edges slide along them and no vertex on a sharp edge is moved: sharp "
+        "edges keep their shape, at a higher E (--keep-sharp-edges)");
   float alpha = float(o.alpha);
   if (ImGui::SliderFloat("alpha (damping)", &alpha, 0.05f, 1.0f, "%.2f")) o.alpha = alpha;
   if (ImGui::IsItemHovered())
@@ -424,6 +429,7 @@ void App::draw_pipeline_options() {
     o.node_optimization = defaults.node_optimization;
     o.max_steps = defaults.max_steps;
     o.descent_steps = defaults.descent_steps;
+    o.keep_sharp_edges = defaults.keep_sharp_edges;
     o.alpha = defaults.alpha;
   }
   ImGui::SameLine();

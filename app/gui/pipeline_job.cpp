@@ -202,6 +202,7 @@ NodeOptOptions editor_node_options(const WorkerOptions& o) {
   NodeOptOptions no;
   no.max_steps = o.descent_steps;
   no.alpha = o.alpha;
+  no.sharp_edges_as_curves = o.keep_sharp_edges;
   no.stiffen_at_end = false;
   return no;
 }

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "core/base/timing.h"
+#include "core/field/curvature.h"
 #include "core/nodeopt/discrete.h"
 #include "core/nodeopt/geodesic.h"
 
@@ -91,10 +92,19 @@ bool pipeline_matches(const Pipeline& p, const TriMesh& mesh, const Layout& layo
   return true;
 }
 
+// A node's position on its curve (NodeOptOptions::slide_on_curves): on the segment from its
+// vertex's original point towards curve neighbour `toward` at fraction t ∈ [0, 1) (toward −1:
+// on the vertex).
+struct CurvePoint {
+  int toward = -1;
+  double t = 0;
+};
+
 struct State {
   TriMesh mesh;
   Layout layout;
   std::vector<SurfacePoint> anchor;  // per node, on the original mesh
+  std::vector<CurvePoint> curve;     // per node (sliding nodes only)
 };
 
 std::vector<std::array<double, 3>> node_positions(const TriMesh& mesh, const Layout& layout) {
@@ -113,6 +123,19 @@ void emit_step(StepReport r, const TriMesh& mesh, const Layout& layout,
   r.node_positions = node_positions(mesh, layout);
   reports.push_back(std::move(r));
   if (observer) observer->on_step(reports.back());
+}
+
+// The curves nodes slide on (NodeOptOptions::slide_on_curves): the layout's feature edges, the
+// boundary and, with sharp_edges_as_curves, the sharp edges of \p mesh at the field's sharp
+// angle. Empty when off.
+CurveNetwork curve_network(const TriMesh& mesh, const Layout& layout,
+                           const PipelineOptions& options, const NodeOptOptions& no) {
+  if (!no.slide_on_curves) return {};
+  if (!no.sharp_edges_as_curves) return make_curve_network(mesh, layout, no.curve_corner_deg);
+  const GeometryCache g = build_geometry(mesh);
+  const std::vector<char> sharp =
+      sharp_edges(mesh, g, options.field.constraints.sharp_angle_deg, nullptr);
+  return make_curve_network(mesh, layout, no.curve_corner_deg, &sharp);
 }
 
 }  // namespace
@@ -143,6 +166,8 @@ struct NodeOptimizer::Impl {
   NodeOptResult result;
   NodeOptStats counters;
   State state;
+  // Feature and boundary curves (slide_on_curves; empty when off).
+  const CurveNetwork curves;
   std::vector<int> movable;
   const GeometryCache original_geometry;
   const double mean_edge;
@@ -170,6 +195,8 @@ struct NodeOptimizer::Impl {
   // Per movable node: the vertex it switched to in the last trial rejected at the current α, or
   // -1 (switch_tabu); and the targets of the trial being built.
   std::vector<int> rejected_target, target;
+  // Per movable node: its step length factor (damp_rejected_slides).
+  std::vector<double> damping;
   std::vector<double> deficits;  // angle deficits of the original mesh (hop_cones), on demand
   int polish_rounds = 0;         // sweeps after a descent phase (max_hop_rounds)
   bool started = false;          // the sweep before the descent (hop_cones_first) is done
@@ -182,14 +209,16 @@ struct NodeOptimizer::Impl {
         no(no_in),
         original(mesh),
         observer(obs),
-        state{mesh, layout, {}},
-        movable(movable_nodes(mesh, layout)),
+        state{mesh, layout, {}, std::vector<CurvePoint>(layout.nodes.size())},
+        curves(curve_network(mesh, layout, options_in, no_in)),
         original_geometry(build_geometry(mesh)),
         mean_edge(original_geometry.mean_edge_length),
         reroute(make_reroute_context(mesh, layout)),
         alpha(no_in.alpha),
         step_budget(no_in.max_steps) {
     for (const auto& n : layout.nodes) state.anchor.push_back(vertex_surface_point(mesh, n.vertex));
+    compute_movable();
+    for (int n : movable) result.sliding_nodes += on_curve(state.layout.nodes[n].vertex);
     check_cancel(observer);
     if (start && pipeline_matches(*start, mesh, layout)) {
       current.pipeline = std::move(start);
@@ -202,7 +231,6 @@ struct NodeOptimizer::Impl {
       current = evaluate_fresh(state.mesh, state.layout, options, true);
       ++counters.fresh_pipelines;
     }
-    rejected_target.assign(movable.size(), -1);
     fewest_folds_count = current.foldovers;
     result.E_init = current.E;
     result.foldovers_init = current.foldovers;
@@ -215,6 +243,156 @@ struct NodeOptimizer::Impl {
     r.time_s = seconds_since(t_start);
     r.phase = "initial";
     emit_step(r, state.mesh, state.layout, result.reports, observer);
+  }
+
+  // Vertex c holds another node than n, or lies on an arc not incident to n.
+  static bool occupied(const Layout& layout, int n, int c, const LayoutObstacles& obstacles) {
+    for (int m = 0; m < static_cast<int>(layout.nodes.size()); ++m)
+      if (m != n && layout.nodes[m].vertex == c) return true;
+    if (!obstacles.routing.vertex_blocked[c]) return false;
+    const int id = layout.nodes[n].id;
+    for (const auto& arc : layout.arcs)
+      if ((arc.from == id || arc.to == id) &&
+          std::find(arc.path.begin(), arc.path.end(), c) != arc.path.end())
+        return false;
+    return true;
+  }
+
+  // A node on this vertex is on a curve: it slides along it while the curve goes on straight
+  // there (curves.slides), and stays on a curve end, junction or corner.
+  bool on_curve(int vertex) const { return !curves.empty() && !curves.neighbours[vertex].empty(); }
+
+  // The nodes that may move: those off the curves as movable_nodes says, those on a curve
+  // (slide_on_curves) when not pinned and not an end of a pinned arc. Whether a node slides or
+  // moves freely depends on the vertex it is on at each step.
+  void compute_movable() {
+    movable.clear();
+    const std::vector<int> free = movable_nodes(original, state.layout);
+    for (int n = 0; n < static_cast<int>(state.layout.nodes.size()); ++n) {
+      const LayoutNode& node = state.layout.nodes[n];
+      if (!on_curve(node.vertex)) {  // movable_nodes' rule
+        if (std::find(free.begin(), free.end(), n) != free.end()) movable.push_back(n);
+        continue;
+      }
+      if (node.pinned) continue;
+      bool pinned_arc = false;
+      for (const auto& arc : state.layout.arcs)
+        pinned_arc |= arc.pinned && (arc.from == node.id || arc.to == node.id);
+      if (!pinned_arc) movable.push_back(n);
+    }
+    rejected_target.assign(movable.size(), -1);
+    damping.assign(movable.size(), 1.0);
+  }
+
+  // Slides movable node \p i (node n, on a curve) of \p trial along its curve by the projection
+  // of −grad[i] (paper §6.1.1): walks the curve polyline (original positions) from the node's
+  // position, stops before a curve end, junction, corner, another node or another arc, and
+  // relocates the nearer end of the segment it reaches (the node's vertex, or the next one
+  // with the arcs along the curve moved with it). False when the node does not move.
+  bool slide_on_curve(State& trial, size_t i, int n, bool no_switch, LayoutObstacles& obstacles,
+                      std::vector<char>& switched) {
+    const int v = trial.layout.nodes[n].vertex;
+    if (!curves.slides[v]) return false;  // it reached a curve end, junction or corner: it stays
+    auto point = [&](int x) { return original.point(original.vertex_handle(x)); };
+    const CurvePoint cp = trial.curve[n];
+    const Vec3 start = cp.toward < 0 ? point(v) : point(v) + cp.t * (point(cp.toward) - point(v));
+    // Travel order: seq[0] behind the start, seq[1] ahead.
+    const Vec3 d = -grad[i];
+    std::vector<int> seq;
+    double best = 0;
+    auto consider = [&](int behind, int ahead) {
+      const Vec3 tangent = point(ahead) - start;
+      const double l = tangent.norm();
+      if (l <= 0) return;
+      const double along = (d | tangent) / l;
+      if (along > best) best = along, seq = {behind, ahead};
+    };
+    if (cp.toward >= 0) {
+      consider(v, cp.toward);
+      consider(cp.toward, v);
+    } else {
+      for (int x : curves.neighbours[v]) consider(v, x);
+    }
+    if (seq.empty()) return false;
+    double remaining = alpha * damping[i] * scale * best;
+    if (remaining < no.min_step_relative * mean_edge) return false;
+    // Vertices the walk may not pass or take: other nodes and other arcs; it stops on a free
+    // curve end, junction or corner (the node then sits on that vertex, which keeps its place).
+    auto occupied = [&](int c) { return c != v && this->occupied(trial.layout, n, c, obstacles); };
+    // Walk: the point ends on segment (seq[k], seq[k+1]) at fraction s from seq[k].
+    size_t k = 0;
+    Vec3 from = start;
+    double s = 0;
+    bool stopped = false;
+    for (size_t guard = 0; guard < curves.neighbours.size(); ++guard) {
+      const Vec3 a = point(seq[k]), b = point(seq[k + 1]);
+      const double seg = (b - a).norm();
+      const double left = (b - from).norm();
+      if (remaining < left || seg <= 0) {
+        s = seg > 0 ? 1 - (left - remaining) / seg : 0;
+        break;
+      }
+      remaining -= left;
+      const int c = seq[k + 1];
+      if (occupied(c)) {  // stop on the segment, halfway to c
+        s = 0.5;
+        stopped = true;
+        break;
+      }
+      if (!curves.slides[c]) {  // on the curve's end, junction or corner
+        s = 1;
+        break;
+      }
+      const auto& nb = curves.neighbours[c];
+      const int next = nb[0] == seq[k] ? nb[1] : nb[0];
+      if (next == v || std::find(seq.begin(), seq.end(), next) != seq.end()) {  // a closed loop
+        s = 0.5;
+        stopped = true;
+        break;
+      }
+      seq.push_back(next);
+      ++k;
+      from = point(c);
+    }
+    if (stopped && k == 0) {  // not past the start
+      const double seg = (point(seq[1]) - point(seq[0])).norm();
+      if (seg <= 0 || (start - point(seq[0])).norm() >= 0.5 * seg) return false;
+    }
+    const Vec3 goal = s >= 1   ? point(seq[k + 1])
+                      : s <= 0 ? point(seq[k])
+                               : point(seq[k]) + s * (point(seq[k + 1]) - point(seq[k]));
+    // The carrying vertex: the nearer end of the segment that may carry the node.
+    const std::vector<int> ends =
+        s <= 0.5 ? std::vector<int>{seq[k], seq[k + 1]} : std::vector<int>{seq[k + 1], seq[k]};
+    const size_t iv = std::find(seq.begin(), seq.end(), v) - seq.begin();
+    for (int w : ends) {
+      if (w != v && (no_switch || occupied(w))) continue;
+      // A vertex that does not slide only carries the node at its own place.
+      if (!curves.slides[w] && (goal - point(w)).norm() > 0) continue;
+      if (!relocation_keeps_orientation(trial.mesh, original, w == v ? -1 : v, w, goal,
+                                        no.relocation))
+        continue;
+      if (w != v) {
+        const size_t iw = std::find(seq.begin(), seq.end(), w) - seq.begin();
+        std::vector<int> walk;  // curve vertices from v to w
+        if (iw >= iv)
+          walk.assign(seq.begin() + iv, seq.begin() + iw + 1);
+        else
+          for (size_t j = iv + 1; j-- > iw;) walk.push_back(seq[j]);
+        if (!move_node_and_reroute(trial.mesh, trial.layout, n, w, no.relocation, &reroute,
+                                   &obstacles, &walk))
+          continue;
+        trial.mesh.set_point(trial.mesh.vertex_handle(v), point(v));
+        switched[i] = 1;
+        target[i] = w;
+      }
+      trial.mesh.set_point(trial.mesh.vertex_handle(w), goal);
+      const int other = w == seq[k] ? seq[k + 1] : seq[k];
+      const double t = w == seq[k] ? s : 1 - s;
+      trial.curve[n] = t > 0 ? CurvePoint{other, t} : CurvePoint{};
+      return true;
+    }
+    return false;
   }
 
   // The Pipeline of a state whose nodes moved to other vertices (re-routed layout): continued
@@ -307,6 +485,7 @@ struct NodeOptimizer::Impl {
     auto sweep_nodes = [&](double min_offset, HopSweepOptions sweep) {
       std::vector<std::pair<double, int>> strained;  // (−offset, node)
       for (int n : movable) {
+        if (on_curve(hopped.layout.nodes[n].vertex)) continue;  // not off its curve
         const auto vh = original.vertex_handle(hopped.layout.nodes[n].vertex);
         const double d = (hopped.mesh.point(vh) - original.point(vh)).norm();
         if (d > 0 && d >= min_offset * mean_edge) strained.push_back({-d, n});
@@ -327,7 +506,11 @@ struct NodeOptimizer::Impl {
     auto find_cones = [&]() {
       if (!no.hop_cones) return;
       if (deficits.empty()) deficits = vertex_angle_deficits(original_geometry);
-      cones = cone_candidates(original, hopped.mesh, hopped.layout, movable,
+      std::vector<int> cone_nodes;  // all but the nodes on the boundary
+      for (int n : movable)
+        if (!original.is_boundary(original.vertex_handle(hopped.layout.nodes[n].vertex)))
+          cone_nodes.push_back(n);
+      cones = cone_candidates(original, hopped.mesh, hopped.layout, cone_nodes,
                               current.pipeline->topology().valence, deficits, no.hop_cone_tolerance,
                               no.hop_cone_rings, no.hop_cone_targets);
     };
@@ -394,8 +577,10 @@ struct NodeOptimizer::Impl {
       for (int n : movable) {  // hopped or restored: the node sits at its vertex's original point
         const int v = hopped.layout.nodes[n].vertex;
         const auto vh = original.vertex_handle(v);
-        if (v != state.layout.nodes[n].vertex || hopped.mesh.point(vh) != state.mesh.point(vh))
+        if (v != state.layout.nodes[n].vertex || hopped.mesh.point(vh) != state.mesh.point(vh)) {
           hopped.anchor[n] = vertex_surface_point(original, v);
+          hopped.curve[n] = CurvePoint{};
+        }
       }
       check_cancel(observer);
       Evaluation next = evaluate_switched(hopped.mesh, hopped.layout);
@@ -431,6 +616,7 @@ struct NodeOptimizer::Impl {
     alpha = no.alpha;
     phase_halvings = 0;
     std::fill(rejected_target.begin(), rejected_target.end(), -1);
+    std::fill(damping.begin(), damping.end(), 1.0);
     step_budget = std::max(step_budget, result.steps + no.hop_descent_steps);
     return true;
   }
@@ -489,9 +675,16 @@ struct NodeOptimizer::Impl {
       int moved = 0;
       // Arc and node obstacles of the trial layout, kept up to date by each re-routing.
       LayoutObstacles obstacles = make_layout_obstacles(trial.mesh, trial.layout);
+      // Vertices on sharp features are not relocated for other nodes (paper §6.1.1).
+      for (size_t v = 0; v < curves.neighbours.size(); ++v)
+        if (!curves.neighbours[v].empty()) obstacles.fixed[v] = 1;
       for (size_t i = 0; i < movable.size(); ++i) {
         const int n = movable[i];
-        const double len = alpha * scale * grad[i].norm();
+        if (on_curve(trial.layout.nodes[n].vertex)) {
+          moved += slide_on_curve(trial, i, n, no_switch[i], obstacles, switched);
+          continue;
+        }
+        const double len = alpha * damping[i] * scale * grad[i].norm();
         if (len < no.min_step_relative * mean_edge) continue;
         auto blocked = [&](int f) {
           if (!no.voronoi_safeguard) return false;
@@ -502,6 +695,33 @@ struct NodeOptimizer::Impl {
         const GeodesicTrace tr = trace_straightest_geodesic(
             original, trial.anchor[n], -grad[i] / grad[i].norm(), len, blocked);
         const int v = trial.layout.nodes[n].vertex;
+        // A step that ends next to a vertex on a sharp edge or feature curve takes the node onto
+        // that vertex at its place (such vertices are not relocated for nodes off the curves).
+        if (!no_switch[i] && !curves.empty()) {
+          int near = -1;
+          double near_d = 0.5 * mean_edge;
+          for (auto vh : original.fv_range(original.face_handle(tr.end.face))) {
+            const double d = (original.point(vh) - tr.end_position).norm();
+            if (d < near_d) near_d = d, near = vh.idx();
+          }
+          if (near >= 0 && near != v && on_curve(near) &&
+              !original.is_boundary(original.vertex_handle(near)) &&
+              !occupied(trial.layout, n, near, obstacles) &&
+              relocation_keeps_orientation(trial.mesh, original, v, near,
+                                           original.point(original.vertex_handle(near)),
+                                           no.relocation) &&
+              move_node_and_reroute(trial.mesh, trial.layout, n, near, no.relocation, &reroute,
+                                    &obstacles)) {
+            trial.mesh.set_point(trial.mesh.vertex_handle(v),
+                                 original.point(original.vertex_handle(v)));
+            trial.anchor[n] = vertex_surface_point(original, near);
+            trial.curve[n] = CurvePoint{};
+            switched[i] = 1;
+            target[i] = near;
+            ++moved;
+            continue;
+          }
+        }
         const std::vector<char> forbidden =
             no_switch[i] ? std::vector<char>(trial.mesh.n_vertices(), 1)
                          : forbidden_relocation_vertices(trial.layout, n, obstacles);
@@ -628,9 +848,9 @@ struct NodeOptimizer::Impl {
     } else {
       ok = !repeated && try_evaluate(trial, switched, next);
     }
+    const bool first_ok = ok && next.E <= current.E;
     if (!repeated && n_switched > 0)
-      rejected_target =
-          ok && next.E <= current.E ? std::vector<int>(movable.size(), -1) : first_target;
+      rejected_target = first_ok ? std::vector<int>(movable.size(), -1) : first_target;
     // A node that changed its vertex can raise E discontinuously: retry once with those nodes
     // kept on their vertices before halving α.
     if (no.retry_without_switches && !(ok && next.E <= current.E) && n_switched > 0) {
@@ -642,10 +862,18 @@ struct NodeOptimizer::Impl {
         ok = true;
       }
     }
+    // The sliding nodes whose switches raised E take half steps from now on (until one of their
+    // switches is accepted or a hop sweep starts a new phase).
+    if (no.damp_rejected_slides && !repeated && n_switched > 0 && !first_ok)
+      for (size_t i = 0; i < movable.size(); ++i)
+        if (first_target[i] >= 0 && on_curve(first_target[i])) damping[i] *= 0.5;
     r.accepted = ok && next.E <= current.E;
     r.E = ok ? next.E : current.E;
     r.foldovers = ok ? next.foldovers : current.foldovers;
     if (r.accepted) {
+      for (size_t i = 0; i < movable.size(); ++i)
+        if (trial.layout.nodes[movable[i]].vertex != state.layout.nodes[movable[i]].vertex)
+          damping[i] = 1;
       note_fold_count(state, next.foldovers);
       state = std::move(trial);
       current = std::move(next);
@@ -695,8 +923,7 @@ struct NodeOptimizer::Impl {
       }
     }
     if (!changed) return;
-    movable = movable_nodes(original, state.layout);
-    rejected_target.assign(movable.size(), -1);
+    compute_movable();
     state_changed = true;  // gradients of the new movable set
   }
 

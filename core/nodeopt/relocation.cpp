@@ -1,6 +1,7 @@
 #include "core/nodeopt/relocation.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/layout/routing.h"
 #include "core/layout/validate.h"
@@ -253,11 +254,47 @@ RerouteContext make_reroute_context(const TriMesh& mesh, const Layout& layout) {
   return c;
 }
 
+CurveNetwork make_curve_network(const TriMesh& mesh, const Layout& layout, double corner_deg,
+                                const std::vector<char>* sharp) {
+  CurveNetwork out;
+  const int nv = static_cast<int>(mesh.n_vertices());
+  out.neighbours.assign(nv, {});
+  out.slides.assign(nv, 0);
+  auto join = [&](int a, int b) {
+    if (a < 0 || b < 0 || a >= nv || b >= nv || a == b) return;
+    auto& na = out.neighbours[a];
+    if (std::find(na.begin(), na.end(), b) != na.end()) return;
+    na.push_back(b);
+    out.neighbours[b].push_back(a);
+  };
+  for (auto e : mesh.edges())
+    if (mesh.is_boundary(e) || (sharp && (*sharp)[e.idx()])) {
+      const auto h = mesh.halfedge_handle(e, 0);
+      join(mesh.from_vertex_handle(h).idx(), mesh.to_vertex_handle(h).idx());
+    }
+  for (const auto& [a, b] : layout.feature_edges) join(a, b);
+  const double min_cos = std::cos(corner_deg * M_PI / 180.0);
+  for (int v = 0; v < nv; ++v) {
+    const auto& n = out.neighbours[v];
+    if (n.size() != 2) continue;
+    const Vec3 p = mesh.point(mesh.vertex_handle(v));
+    Vec3 in = p - mesh.point(mesh.vertex_handle(n[0]));
+    Vec3 on = mesh.point(mesh.vertex_handle(n[1])) - p;
+    const double li = in.norm(), lo = on.norm();
+    if (li <= 0 || lo <= 0) continue;
+    out.slides[v] = (in | on) / (li * lo) >= min_cos;
+  }
+  return out;
+}
+
 bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, int new_vertex,
                            const RelocationOptions& options, const RerouteContext* context,
-                           LayoutObstacles* cache) {
+                           LayoutObstacles* cache, const std::vector<int>* curve_walk) {
   const int old_vertex = layout.nodes[node_index].vertex;
   if (new_vertex == old_vertex) return true;
+  if (curve_walk && (curve_walk->size() < 2 || curve_walk->front() != old_vertex ||
+                     curve_walk->back() != new_vertex))
+    return false;
   const int id = layout.nodes[node_index].id;
   // The new vertex must be free: no other node, no arc that is not incident to the node.
   for (int n = 0; n < static_cast<int>(layout.nodes.size()); ++n)
@@ -265,7 +302,16 @@ bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, 
   for (const LayoutArc& arc : layout.arcs) {
     if (arc.from == id || arc.to == id) continue;
     if (std::find(arc.path.begin(), arc.path.end(), new_vertex) != arc.path.end()) return false;
+    if (curve_walk)  // the walk is free as well
+      for (size_t j = 1; j < curve_walk->size(); ++j)
+        if (std::find(arc.path.begin(), arc.path.end(), (*curve_walk)[j]) != arc.path.end())
+          return false;
   }
+  if (curve_walk)
+    for (size_t n = 0; n < layout.nodes.size(); ++n)
+      for (size_t j = 1; j < curve_walk->size(); ++j)
+        if (static_cast<int>(n) != node_index && layout.nodes[n].vertex == (*curve_walk)[j])
+          return false;
   const std::vector<int> rotation = rotation_at(mesh, layout, node_index);
   // Incident arcs, in the node's cyclic order (a loop arc appears twice: skip those).
   std::vector<int> incident;
@@ -317,35 +363,81 @@ bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, 
     base = obstacles_of_layout(mesh, cleared);
   }
 
+  // A slide along a curve: the arcs along the curve get their paths from the walk (the same
+  // for every splice attempt); `along[i]`: 1 follows the walk, 2 leaves the other way.
+  std::vector<char> along(incident.size(), 0);
+  if (curve_walk) {
+    const std::vector<int>& walk = *curve_walk;
+    for (size_t i = 0; i < incident.size(); ++i) {
+      const LayoutArc& arc = layout.arcs[incident[i]];
+      std::vector<int> path = arc.path;
+      if (arc.from != id) std::reverse(path.begin(), path.end());
+      if (path.size() < 2) continue;
+      if (path[1] == walk[1]) {  // must follow the whole walk and go on beyond it
+        if (path.size() < walk.size() || (path.size() == walk.size() && !arc.dangling()))
+          return false;
+        if (!std::equal(walk.begin(), walk.end(), path.begin())) return false;
+        along[i] = 1;
+      }
+    }
+    // The curve edge at the old vertex that the walk does not take: an arc leaving along it
+    // takes the walk back.
+    for (size_t i = 0; i < incident.size(); ++i) {
+      if (along[i]) continue;
+      const LayoutArc& arc = layout.arcs[incident[i]];
+      std::vector<int> path = arc.path;
+      if (arc.from != id) std::reverse(path.begin(), path.end());
+      if (path.size() < 2) continue;
+      const int next = path[1];
+      const auto h = mesh.find_halfedge(mesh.vertex_handle(old_vertex), mesh.vertex_handle(next));
+      bool curve_edge = h.is_valid() && mesh.is_boundary(mesh.edge_handle(h));
+      for (const auto& [a, b] : layout.feature_edges)
+        curve_edge |= (a == old_vertex && b == next) || (b == old_vertex && a == next);
+      if (curve_edge) along[i] = 2;
+    }
+  }
+
   for (int k = 2; k <= std::max(2, options.max_splice_edges); ++k) {
     Layout trial = layout;
     trial.nodes[node_index].vertex = new_vertex;
     // Oriented paths (from the moving node) and the kept tails.
-    std::vector<std::vector<int>> tails(incident.size());
+    std::vector<std::vector<int>> tails(incident.size()), fixed_heads(incident.size());
     for (size_t i = 0; i < incident.size(); ++i) {
       LayoutArc& arc = trial.arcs[incident[i]];
       std::vector<int> path = arc.path;
       if (arc.from != id) std::reverse(path.begin(), path.end());
-      // If the new vertex lies on this arc, keep everything after it.
-      const auto on = std::find(path.begin(), path.end(), new_vertex);
-      size_t cut = std::min<size_t>(k, path.size() - 1);
-      if (on != path.end()) cut = std::max<size_t>(cut, on - path.begin());
-      // Never cut at the far end of a non-dangling arc beyond its last vertex.
-      tails[i].assign(path.begin() + cut, path.end());
+      if (along[i] == 1) {  // from the new vertex on
+        tails[i].assign(path.begin() + (curve_walk->size() - 1), path.end());
+        fixed_heads[i] = {new_vertex};
+      } else if (along[i] == 2) {  // the walk back, then the whole old path
+        tails[i] = path;
+        fixed_heads[i].assign(curve_walk->rbegin(), curve_walk->rend());
+      } else {
+        // If the new vertex lies on this arc, keep everything after it.
+        const auto on = std::find(path.begin(), path.end(), new_vertex);
+        size_t cut = std::min<size_t>(k, path.size() - 1);
+        if (on != path.end()) cut = std::max<size_t>(cut, on - path.begin());
+        // Never cut at the far end of a non-dangling arc beyond its last vertex.
+        tails[i].assign(path.begin() + cut, path.end());
+      }
       arc.path.clear();
     }
     RoutingObstacles obstacles = base;
-    for (const auto& tail : tails) {
-      for (size_t j = 0; j < tail.size(); ++j) {
-        obstacles.vertex_blocked[tail[j]] = 1;
-        if (j > 0) obstacles.edge_blocked[edge_of(tail[j - 1], tail[j])] = 1;
+    auto mark = [&](const std::vector<int>& chain) {
+      for (size_t j = 0; j < chain.size(); ++j) {
+        obstacles.vertex_blocked[chain[j]] = 1;
+        if (j > 0) obstacles.edge_blocked[edge_of(chain[j - 1], chain[j])] = 1;
       }
-    }
+    };
+    for (const auto& tail : tails) mark(tail);
+    for (const auto& head : fixed_heads) mark(head);
     bool ok = true;
     for (size_t i = 0; i < incident.size() && ok; ++i) {
       LayoutArc& arc = trial.arcs[incident[i]];
       std::vector<int> head;
-      if (tails[i].front() == new_vertex) {
+      if (!fixed_heads[i].empty()) {
+        head = fixed_heads[i];
+      } else if (tails[i].front() == new_vertex) {
         head = {new_vertex};
       } else {
         head = shortest_path(mesh, new_vertex, tails[i].front(), obstacles);

@@ -86,6 +86,25 @@ std::vector<char> forbidden_relocation_vertices(const TriMesh& mesh, const Layou
 std::vector<char> forbidden_relocation_vertices(const Layout& layout, int node_index,
                                                 const LayoutObstacles& obstacles);
 
+//! The curves on which nodes slide (paper §6.1.1: "if h lies on a feature curve, we first
+//! project d(h) onto it and restrict the tracing to this curve"): the layout's feature edges,
+//! sharp edges and the mesh boundary.
+struct CurveNetwork {
+  //! Per vertex (size #V): the vertices joined to it by a curve edge.
+  std::vector<std::vector<int>> neighbours;
+  //! Per vertex (size #V): a node here slides along the curve. True when the vertex has exactly
+  //! two curve neighbours and the curve turns there by at most the corner angle (a node on a
+  //! curve's end, a junction or a corner stays).
+  std::vector<char> slides;
+  bool empty() const { return neighbours.empty(); }
+};
+
+//! The curve network of \p layout on \p mesh (original positions); \p corner_deg: the largest
+//! turn of a curve at a vertex on which a node still slides (degrees). \p sharp, when given
+//! (per edge, size #E), marks further feature edges (the sharp edges the cross field aligns to).
+CurveNetwork make_curve_network(const TriMesh& mesh, const Layout& layout, double corner_deg,
+                                const std::vector<char>* sharp = nullptr);
+
 //! Moves node \p node_index of \p layout to \p new_vertex and re-routes its incident arcs: each
 //! arc keeps its old path from k edges after the node on (k = 2, 3, … max_splice_edges; the
 //! whole arc when it is shorter) and gets a new shortest first part from the new vertex that
@@ -98,11 +117,16 @@ std::vector<char> forbidden_relocation_vertices(const Layout& layout, int node_i
 //! checked (RelocationOptions::full_validation re-validates everything). \p context, when
 //! given, supplies the patch count. \p obstacles, when given, must hold
 //! make_layout_obstacles(mesh, layout); it is updated when the move is kept.
+//! \p curve_walk, when given, is a node sliding along a curve: the curve vertices from the node's
+//! vertex to \p new_vertex (its first and last entries). An arc that follows the walk keeps its
+//! path from \p new_vertex on, an arc that leaves the node along the curve the other way gets the
+//! walk prepended (both stay on the curve); the node's other arcs are re-routed as above.
 //! \pre layout is valid on \p mesh (connectivity only; positions give the routing metric).
 bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, int new_vertex,
                            const RelocationOptions& options = {},
                            const RerouteContext* context = nullptr,
-                           LayoutObstacles* obstacles = nullptr);
+                           LayoutObstacles* obstacles = nullptr,
+                           const std::vector<int>* curve_walk = nullptr);
 
 //! Same patch count and the same cyclic order of half-arcs around every node.
 bool same_layout_structure(const LayoutTopology& a, const LayoutTopology& b);

@@ -43,6 +43,7 @@ struct WorkerOptions {
   double anisotropy = 10.0;       //!< anisotropic norm factor of the parameterization energy
   double alpha = 0.75;            //!< initial damping α of node-optimization steps
   int descent_steps = 25;         //!< descent steps before the first hop sweep (--steps)
+  bool keep_sharp_edges = false;  //!< sharp edges as feature curves (--keep-sharp-edges)
 };
 
 //! What a step function sees of the job: a qs::Observer, so it can be handed straight to
