@@ -66,9 +66,10 @@ TEST(CurveSliding, BoundaryNodeSlidesBack) {
   Layout layout = grid.layout;
   const int n = node_at(layout, grid_vertex(nx, 6, 0));
   ASSERT_GE(n, 0);
-  const std::vector<int> walk{grid_vertex(nx, 6, 0), grid_vertex(nx, 7, 0), grid_vertex(nx, 8, 0)};
-  ASSERT_TRUE(
-      move_node_and_reroute(grid.mesh, layout, n, walk.back(), {}, nullptr, nullptr, &walk));
+  const CurveWalk walk{{grid_vertex(nx, 6, 0), grid_vertex(nx, 7, 0), grid_vertex(nx, 8, 0)},
+                       grid_vertex(nx, 5, 0)};
+  ASSERT_TRUE(move_node_and_reroute(grid.mesh, layout, n, walk.vertices.back(), {}, nullptr,
+                                    nullptr, &walk));
   ASSERT_TRUE(validate_layout(grid.mesh, layout).valid());
   std::vector<int> bottom;
   for (int i = 0; i <= nx; ++i) bottom.push_back(grid_vertex(nx, i, 0));
@@ -91,7 +92,7 @@ TEST(CurveSliding, BoundaryNodeSlidesBack) {
   EXPECT_NEAR(c[0], p[0], 1e-6);
   EXPECT_LT(r.E_final, 1e-9 * r.E_init);
   EXPECT_GT(off.result.E_final, 0.1 * r.E_init) << "without sliding the node stays displaced";
-  EXPECT_EQ(off.result.layout.nodes[n].vertex, walk.back());
+  EXPECT_EQ(off.result.layout.nodes[n].vertex, walk.vertices.back());
   EXPECT_TRUE(curve_covered_by_arcs(r.layout, bottom));
   EXPECT_TRUE(validate_layout(r.mesh, r.layout).valid());
   EXPECT_TRUE(on.equivalent);
@@ -111,9 +112,10 @@ TEST(CurveSliding, FeatureNodeSlidesAlongTheFeature) {
     layout.feature_edges.push_back({line[k], line[k + 1]});
   const int n = node_at(layout, grid_vertex(nx, 6, 6));
   ASSERT_GE(n, 0);
-  const std::vector<int> walk{grid_vertex(nx, 6, 6), grid_vertex(nx, 6, 7), grid_vertex(nx, 6, 8)};
-  ASSERT_TRUE(
-      move_node_and_reroute(grid.mesh, layout, n, walk.back(), {}, nullptr, nullptr, &walk));
+  const CurveWalk walk{{grid_vertex(nx, 6, 6), grid_vertex(nx, 6, 7), grid_vertex(nx, 6, 8)},
+                       grid_vertex(nx, 6, 5)};
+  ASSERT_TRUE(move_node_and_reroute(grid.mesh, layout, n, walk.vertices.back(), {}, nullptr,
+                                    nullptr, &walk));
   ASSERT_TRUE(validate_layout(grid.mesh, layout).valid());
   ASSERT_TRUE(curve_covered_by_arcs(layout, line));
 
@@ -134,7 +136,7 @@ TEST(CurveSliding, FeatureNodeSlidesAlongTheFeature) {
   }
   EXPECT_LT(r.E_final, 1e-9 * r.E_init);
   EXPECT_GT(off.result.E_final, 0.1 * r.E_init) << "without sliding the node stays displaced";
-  EXPECT_EQ(off.result.layout.nodes[n].vertex, walk.back());
+  EXPECT_EQ(off.result.layout.nodes[n].vertex, walk.vertices.back());
   EXPECT_TRUE(curve_covered_by_arcs(r.layout, line));
   EXPECT_TRUE(on.equivalent);
   EXPECT_EQ(r.foldovers_final, 0);

@@ -374,11 +374,13 @@ struct NodeOptimizer::Impl {
         continue;
       if (w != v) {
         const size_t iw = std::find(seq.begin(), seq.end(), w) - seq.begin();
-        std::vector<int> walk;  // curve vertices from v to w
+        CurveWalk walk;  // the curve vertices from v to w
         if (iw >= iv)
-          walk.assign(seq.begin() + iv, seq.begin() + iw + 1);
+          walk.vertices.assign(seq.begin() + iv, seq.begin() + iw + 1);
         else
-          for (size_t j = iv + 1; j-- > iw;) walk.push_back(seq[j]);
+          for (size_t j = iv + 1; j-- > iw;) walk.vertices.push_back(seq[j]);
+        for (int x : curves.neighbours[v])
+          if (x != walk.vertices[1]) walk.behind = x;
         if (!move_node_and_reroute(trial.mesh, trial.layout, n, w, no.relocation, &reroute,
                                    &obstacles, &walk))
           continue;

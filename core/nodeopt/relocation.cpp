@@ -289,7 +289,8 @@ CurveNetwork make_curve_network(const TriMesh& mesh, const Layout& layout, doubl
 
 bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, int new_vertex,
                            const RelocationOptions& options, const RerouteContext* context,
-                           LayoutObstacles* cache, const std::vector<int>* curve_walk) {
+                           LayoutObstacles* cache, const CurveWalk* curve) {
+  const std::vector<int>* curve_walk = curve ? &curve->vertices : nullptr;
   const int old_vertex = layout.nodes[node_index].vertex;
   if (new_vertex == old_vertex) return true;
   if (curve_walk && (curve_walk->size() < 2 || curve_walk->front() != old_vertex ||
@@ -380,20 +381,13 @@ bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, 
         along[i] = 1;
       }
     }
-    // The curve edge at the old vertex that the walk does not take: an arc leaving along it
-    // takes the walk back.
-    for (size_t i = 0; i < incident.size(); ++i) {
+    // An arc leaving along the curve edge the walk turns its back on takes the walk back.
+    for (size_t i = 0; i < incident.size() && curve->behind >= 0; ++i) {
       if (along[i]) continue;
       const LayoutArc& arc = layout.arcs[incident[i]];
       std::vector<int> path = arc.path;
       if (arc.from != id) std::reverse(path.begin(), path.end());
-      if (path.size() < 2) continue;
-      const int next = path[1];
-      const auto h = mesh.find_halfedge(mesh.vertex_handle(old_vertex), mesh.vertex_handle(next));
-      bool curve_edge = h.is_valid() && mesh.is_boundary(mesh.edge_handle(h));
-      for (const auto& [a, b] : layout.feature_edges)
-        curve_edge |= (a == old_vertex && b == next) || (b == old_vertex && a == next);
-      if (curve_edge) along[i] = 2;
+      if (path.size() >= 2 && path[1] == curve->behind) along[i] = 2;
     }
   }
 

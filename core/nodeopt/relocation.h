@@ -105,6 +105,13 @@ struct CurveNetwork {
 CurveNetwork make_curve_network(const TriMesh& mesh, const Layout& layout, double corner_deg,
                                 const std::vector<char>* sharp = nullptr);
 
+//! A node sliding along a curve to another vertex (move_node_and_reroute).
+struct CurveWalk {
+  std::vector<int> vertices;  //!< the curve vertices from the node's vertex to the new one
+  //! The old vertex's other curve neighbour (the one the walk turns its back on), or -1.
+  int behind = -1;
+};
+
 //! Moves node \p node_index of \p layout to \p new_vertex and re-routes its incident arcs: each
 //! arc keeps its old path from k edges after the node on (k = 2, 3, … max_splice_edges; the
 //! whole arc when it is shorter) and gets a new shortest first part from the new vertex that
@@ -117,16 +124,16 @@ CurveNetwork make_curve_network(const TriMesh& mesh, const Layout& layout, doubl
 //! checked (RelocationOptions::full_validation re-validates everything). \p context, when
 //! given, supplies the patch count. \p obstacles, when given, must hold
 //! make_layout_obstacles(mesh, layout); it is updated when the move is kept.
-//! \p curve_walk, when given, is a node sliding along a curve: the curve vertices from the node's
-//! vertex to \p new_vertex (its first and last entries). An arc that follows the walk keeps its
-//! path from \p new_vertex on, an arc that leaves the node along the curve the other way gets the
-//! walk prepended (both stay on the curve); the node's other arcs are re-routed as above.
+//! \p curve_walk, when given, is a node sliding along a curve (its vertices run from the node's
+//! vertex to \p new_vertex). An arc that follows the walk keeps its path from \p new_vertex on, an
+//! arc that leaves the node towards `behind` gets the walk prepended (both stay on the curve); the
+//! node's other arcs are re-routed as above.
 //! \pre layout is valid on \p mesh (connectivity only; positions give the routing metric).
 bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, int new_vertex,
                            const RelocationOptions& options = {},
                            const RerouteContext* context = nullptr,
                            LayoutObstacles* obstacles = nullptr,
-                           const std::vector<int>* curve_walk = nullptr);
+                           const CurveWalk* curve_walk = nullptr);
 
 //! Same patch count and the same cyclic order of half-arcs around every node.
 bool same_layout_structure(const LayoutTopology& a, const LayoutTopology& b);
