@@ -42,6 +42,16 @@ bool curve_covered_by_arcs(const Layout& layout, const std::vector<int>& curve) 
   return true;
 }
 
+// Moves the node on the walk's first vertex to its last one, the arcs along the curve with it;
+// returns the node's index, or -1 when the move or the moved layout is not valid.
+int displace(const TriMesh& mesh, Layout& layout, const CurveWalk& walk) {
+  const int n = node_at(layout, walk.vertices.front());
+  if (n < 0 ||
+      !move_node_and_reroute(mesh, layout, n, walk.vertices.back(), {}, nullptr, nullptr, &walk))
+    return -1;
+  return validate_layout(mesh, layout).valid() ? n : -1;
+}
+
 struct SlideRun {
   NodeOptResult result;
   bool equivalent = false;
@@ -58,19 +68,31 @@ SlideRun optimize(const TriMesh& mesh, const Layout& layout, bool slide) {
   return run;
 }
 
+// What both displaced nodes must show: the residual gone (the flat grid is isometric again),
+// the run without sliding left the node where it was, the curve still covered by arcs, a valid
+// and structurally equivalent layout without fold-overs.
+void expect_slid(const SlideRun& on, const SlideRun& off, int n, const CurveWalk& walk,
+                 const std::vector<int>& curve) {
+  const NodeOptResult& r = on.result;
+  EXPECT_LT(r.E_final, 1e-9 * r.E_init);
+  EXPECT_GT(off.result.E_final, 0.1 * r.E_init) << "without sliding the node stays displaced";
+  EXPECT_EQ(off.result.layout.nodes[n].vertex, walk.vertices.back());
+  EXPECT_TRUE(curve_covered_by_arcs(r.layout, curve));
+  EXPECT_TRUE(validate_layout(r.mesh, r.layout).valid());
+  EXPECT_TRUE(on.equivalent);
+  EXPECT_EQ(r.foldovers_final, 0);
+}
+
 // A T-node on the boundary of a flat 2×2 grid layout, displaced two edges along the boundary,
 // slides until the layout's middle line is straight again (the flat grid is then isometric).
 TEST(CurveSliding, BoundaryNodeSlidesBack) {
   const int nx = 12;
   const auto grid = test::disk_grid(nx, 12, 2, 2);
   Layout layout = grid.layout;
-  const int n = node_at(layout, grid_vertex(nx, 6, 0));
-  ASSERT_GE(n, 0);
   const CurveWalk walk{{grid_vertex(nx, 6, 0), grid_vertex(nx, 7, 0), grid_vertex(nx, 8, 0)},
                        grid_vertex(nx, 5, 0)};
-  ASSERT_TRUE(move_node_and_reroute(grid.mesh, layout, n, walk.vertices.back(), {}, nullptr,
-                                    nullptr, &walk));
-  ASSERT_TRUE(validate_layout(grid.mesh, layout).valid());
+  const int n = displace(grid.mesh, layout, walk);
+  ASSERT_GE(n, 0);
   std::vector<int> bottom;
   for (int i = 0; i <= nx; ++i) bottom.push_back(grid_vertex(nx, i, 0));
   ASSERT_TRUE(curve_covered_by_arcs(layout, bottom)) << "the displaced arcs left the boundary";
@@ -90,13 +112,7 @@ TEST(CurveSliding, BoundaryNodeSlidesBack) {
   const int centre = node_at(grid.layout, grid_vertex(nx, 6, 6));
   const Vec3 c = r.mesh.point(r.mesh.vertex_handle(r.layout.nodes[centre].vertex));
   EXPECT_NEAR(c[0], p[0], 1e-6);
-  EXPECT_LT(r.E_final, 1e-9 * r.E_init);
-  EXPECT_GT(off.result.E_final, 0.1 * r.E_init) << "without sliding the node stays displaced";
-  EXPECT_EQ(off.result.layout.nodes[n].vertex, walk.vertices.back());
-  EXPECT_TRUE(curve_covered_by_arcs(r.layout, bottom));
-  EXPECT_TRUE(validate_layout(r.mesh, r.layout).valid());
-  EXPECT_TRUE(on.equivalent);
-  EXPECT_EQ(r.foldovers_final, 0);
+  expect_slid(on, off, n, walk, bottom);
 }
 
 // The centre node of the same layout on an explicit feature curve (the vertical middle grid
@@ -110,13 +126,10 @@ TEST(CurveSliding, FeatureNodeSlidesAlongTheFeature) {
   for (int j = 0; j <= 12; ++j) line.push_back(grid_vertex(nx, 6, j));
   for (size_t k = 0; k + 1 < line.size(); ++k)
     layout.feature_edges.push_back({line[k], line[k + 1]});
-  const int n = node_at(layout, grid_vertex(nx, 6, 6));
-  ASSERT_GE(n, 0);
   const CurveWalk walk{{grid_vertex(nx, 6, 6), grid_vertex(nx, 6, 7), grid_vertex(nx, 6, 8)},
                        grid_vertex(nx, 6, 5)};
-  ASSERT_TRUE(move_node_and_reroute(grid.mesh, layout, n, walk.vertices.back(), {}, nullptr,
-                                    nullptr, &walk));
-  ASSERT_TRUE(validate_layout(grid.mesh, layout).valid());
+  const int n = displace(grid.mesh, layout, walk);
+  ASSERT_GE(n, 0);
   ASSERT_TRUE(curve_covered_by_arcs(layout, line));
 
   const SlideRun on = optimize(grid.mesh, layout, true);
@@ -134,12 +147,7 @@ TEST(CurveSliding, FeatureNodeSlidesAlongTheFeature) {
     const Vec3 q = r.mesh.point(r.mesh.vertex_handle(r.layout.nodes[side].vertex));
     EXPECT_NEAR(q[1], p[1], 1e-6);
   }
-  EXPECT_LT(r.E_final, 1e-9 * r.E_init);
-  EXPECT_GT(off.result.E_final, 0.1 * r.E_init) << "without sliding the node stays displaced";
-  EXPECT_EQ(off.result.layout.nodes[n].vertex, walk.vertices.back());
-  EXPECT_TRUE(curve_covered_by_arcs(r.layout, line));
-  EXPECT_TRUE(on.equivalent);
-  EXPECT_EQ(r.foldovers_final, 0);
+  expect_slid(on, off, n, walk, line);
   // Every relocated vertex of the result stays on the original surface (z = 0); the ones on
   // the feature line stay on it.
   for (auto vh : r.mesh.vertices()) {
