@@ -250,8 +250,9 @@ StepResult pipeline_step(WorkerState& state, const WorkerObserver& observer) {
     changed |= r.accepted;
     what << (k > reports_before ? "; " : "") << r.phase << " step " << r.step
          << (r.accepted             ? " accepted"
-             : r.phase == "descent" ? " rejected (step size halved)"
-                                    : " kept nothing");
+             : r.phase != "descent" ? " kept nothing"
+             : r.moved_nodes == 0   ? " converged"
+                                    : " rejected (step size halved)");
   }
   std::string prefix = what.str();
   StepResult result;
