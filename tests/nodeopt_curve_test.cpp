@@ -10,6 +10,7 @@
 #include "core/layout/perturb.h"
 #include "core/layout/validate.h"
 #include "core/mesh/geometry.h"
+#include "core/nodeopt/discrete.h"
 #include "core/nodeopt/optimizer.h"
 #include "core/nodeopt/relocation.h"
 #include "core/pipeline/pipeline.h"
@@ -209,6 +210,52 @@ TEST(CurveSliding, SharpEdgesKeepTheirShape) {
   EXPECT_EQ(off_keep, 0);
   EXPECT_GT(off_free, 0) << "the case should relocate sharp vertices without the option";
   EXPECT_EQ(off_lines(r.mesh), 0);
+}
+
+// A hop along a curve (hop_sweep with HopSweepOptions::curves): the displaced boundary node,
+// its vertex relocated along the boundary towards where it belongs, hops to that boundary
+// neighbour (a boundary vertex, which other hops may not take) with its arcs along the
+// boundary; without the curves the same target is refused.
+TEST(CurveSliding, HopAlongTheBoundary) {
+  const int nx = 12;
+  const auto grid = test::disk_grid(nx, 12, 2, 2);
+  Layout layout = grid.layout;
+  const CurveWalk walk{{grid_vertex(nx, 6, 0), grid_vertex(nx, 7, 0)}, grid_vertex(nx, 5, 0)};
+  const int n = displace(grid.mesh, layout, walk);
+  ASSERT_GE(n, 0);
+  TriMesh mesh = grid.mesh;  // the node's vertex (7, 0) relocated to x = 6.6, towards (6, 0)
+  const auto vh = mesh.vertex_handle(grid_vertex(nx, 7, 0));
+  mesh.set_point(vh, Vec3(6.6, 0, 0));
+  const HopEvaluator evaluate = [](const TriMesh& m, const Layout& l, double& E, int& folds) {
+    Pipeline p(m, l, PipelineOptions{}, false);
+    const Parameterization& par = p.compute_parameterization();
+    E = unweighted_energy(p.mesh(), p.geometry(), p.field()->theta, par, PipelineOptions{}.param);
+    folds = par.foldovers;
+    return true;
+  };
+  double E0 = 0;
+  int folds0 = 0;
+  ASSERT_TRUE(evaluate(mesh, layout, E0, folds0));
+  const CurveNetwork curves = make_curve_network(grid.mesh, layout, 30.0);
+  HopSweepOptions options;
+  options.targets = {{grid_vertex(nx, 6, 0)}};
+  TriMesh refused_mesh = mesh;
+  Layout refused = layout;
+  const HopSweepResult none =
+      hop_sweep(grid.mesh, refused_mesh, refused, {n}, {}, E0, folds0, options, evaluate);
+  EXPECT_EQ(none.moved, 0) << "a boundary vertex is no target for a plain hop";
+  options.curves = &curves;
+  const HopSweepResult r =
+      hop_sweep(grid.mesh, mesh, layout, {n}, {}, E0, folds0, options, evaluate);
+  std::printf("[stat] hop along the boundary: E %.4g -> %.4g\n", E0, r.E);
+  ASSERT_EQ(r.moved, 1);
+  EXPECT_EQ(layout.nodes[n].vertex, grid_vertex(nx, 6, 0));
+  EXPECT_EQ(mesh.point(vh), grid.mesh.point(vh)) << "the vertex it left is back in place";
+  EXPECT_LT(r.E, 1e-9 * E0);
+  std::vector<int> bottom;
+  for (int i = 0; i <= nx; ++i) bottom.push_back(grid_vertex(nx, i, 0));
+  EXPECT_TRUE(curve_covered_by_arcs(layout, bottom));
+  EXPECT_TRUE(validate_layout(mesh, layout).valid());
 }
 
 // Curve ends, junctions and corners do not slide.

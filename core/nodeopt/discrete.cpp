@@ -178,10 +178,16 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
       list.push_back(std::move(c));
     }
     std::vector<int> vertices;
+    // Curve neighbours of v (o.curves): steps along the curve.
+    const std::vector<int> no_curve;
+    const std::vector<int>& along = o.curves ? o.curves->neighbours[v] : no_curve;
+    auto on_curve_step = [&](int w) {
+      return std::find(along.begin(), along.end(), w) != along.end();
+    };
     if (!o.targets.empty()) {
       const std::vector<char> forbidden = forbidden_relocation_vertices(original, layout, n);
       for (int w : o.targets[i]) {
-        if (w != v && !forbidden[w]) vertices.push_back(w);
+        if (w != v && (!forbidden[w] || on_curve_step(w))) vertices.push_back(w);
       }
     } else if (o.try_neighbours) {
       vertices = hop_candidates(original, layout, n, direction, o);
@@ -192,7 +198,15 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
       if (!relocation_keeps_orientation(mesh, original, v, w, at, o.relocation)) continue;
       Candidate c;
       c.layout = layout;
-      if (!move_node_and_reroute(mesh, c.layout, n, w, o.relocation, context)) continue;
+      CurveWalk walk;
+      if (on_curve_step(w)) {
+        walk.vertices = {v, w};
+        for (int x : along)
+          if (x != w) walk.behind = x;
+      }
+      if (!move_node_and_reroute(mesh, c.layout, n, w, o.relocation, context, nullptr,
+                                 walk.vertices.empty() ? nullptr : &walk))
+        continue;
       list.push_back(std::move(c));
     }
     if (!list.empty()) solve_candidates(list, v, restored);

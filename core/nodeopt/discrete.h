@@ -65,6 +65,10 @@ struct HopSweepOptions {
   //! targets[i], in order (any vertices, not only neighbours; forbidden ones are skipped),
   //! instead of its neighbours.
   std::vector<std::vector<int>> targets;
+  //! With targets: a target that is a curve neighbour of the node's vertex on these curves is a
+  //! step along the curve (its vertex may lie on the curve; the node's arcs along the curve move
+  //! with it, move_node_and_reroute's CurveWalk).
+  const CurveNetwork* curves = nullptr;
   //! The sweep stops after this many candidate solves in a row that found no lower E
   //! (≤ 0: no limit); with the most promising nodes first, the rest rarely pays.
   int max_failures = 0;

@@ -573,6 +573,26 @@ struct NodeOptimizer::Impl {
       sweep.min_direction_cos = no.hop_min_cos;
       sweep.max_failures = no.hop_max_failures;
       sweep_nodes(no.hop_min_offset, sweep);
+      // Sliding nodes relocated along their curve hop to the curve neighbour they lean to.
+      std::vector<std::pair<double, int>> leaning;  // (−t, node)
+      for (int n : movable) {
+        const int v = hopped.layout.nodes[n].vertex;
+        const auto vh = original.vertex_handle(v);
+        if (on_curve(v) && curves.slides[v] && hopped.curve[n].toward >= 0 &&
+            hopped.mesh.point(vh) != original.point(vh))
+          leaning.push_back({-hopped.curve[n].t, n});
+      }
+      std::sort(leaning.begin(), leaning.end());
+      HopSweepOptions along;
+      along.curves = &curves;
+      along.max_failures = no.hop_max_failures;
+      std::vector<int> nodes;
+      for (const auto& [t, n] : leaning) {
+        nodes.push_back(n);
+        along.targets.push_back({hopped.curve[n].toward});
+      }
+      along.max_evaluations = no.hop_max_evaluations - h.evaluations;
+      run_sweep(nodes, {}, along, true);
     }
     bool kept = false;
     if (h.moved > 0) {
