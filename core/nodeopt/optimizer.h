@@ -40,8 +40,10 @@ struct NodeOptOptions {
   //! it (paper §6.1.1): the descent direction projected onto the curve, the walk restricted to
   //! it, the node's vertex relocated along the curve segment, the arcs along the curve moved
   //! with the node. A node where the curve ends, branches or turns by more than
-  //! curve_corner_deg stays (as do all such nodes when false). Hop sweeps leave these nodes
-  //! alone (a hop could take them off their curve).
+  //! curve_corner_deg stays (as do all such nodes when false). No other node relocates a vertex
+  //! on these curves; a step ending within half an edge of one takes the node onto it, unmoved.
+  //! In hop sweeps a sliding node tries only the curve neighbour its relocation leans to (and
+  //! the cone passes, off the boundary).
   bool slide_on_curves = true;
   double curve_corner_deg = 30.0;
   //! The sharp edges (at the field's sharp angle) count as feature curves too: nodes on them
