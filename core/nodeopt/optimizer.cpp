@@ -365,11 +365,15 @@ struct NodeOptimizer::Impl {
     const std::vector<int> ends =
         s <= 0.5 ? std::vector<int>{seq[k], seq[k + 1]} : std::vector<int>{seq[k + 1], seq[k]};
     const size_t iv = std::find(seq.begin(), seq.end(), v) - seq.begin();
+    const Vec3 middle = 0.5 * (point(seq[k]) + point(seq[k + 1]));
     for (int w : ends) {
       if (w != v && (no_switch || occupied(w))) continue;
       // A vertex that does not slide only carries the node at its own place.
       if (!curves.slides[w] && (goal - point(w)).norm() > 0) continue;
-      if (!relocation_keeps_orientation(trial.mesh, original, w == v ? -1 : v, w, goal,
+      // The farther end carries the node at most to the segment's middle: a vertex relocated
+      // further along the curve would squeeze its faces on the other side.
+      const Vec3 at = w == ends[0] ? goal : middle;
+      if (!relocation_keeps_orientation(trial.mesh, original, w == v ? -1 : v, w, at,
                                         no.relocation))
         continue;
       if (w != v) {
@@ -388,9 +392,10 @@ struct NodeOptimizer::Impl {
         switched[i] = 1;
         target[i] = w;
       }
-      trial.mesh.set_point(trial.mesh.vertex_handle(w), goal);
+      trial.mesh.set_point(trial.mesh.vertex_handle(w), at);
       const int other = w == seq[k] ? seq[k + 1] : seq[k];
-      const double t = w == seq[k] ? s : 1 - s;
+      const double sw = w == ends[0] ? s : 0.5;  // the fraction carried, from seq[k]
+      const double t = w == seq[k] ? sw : 1 - sw;
       trial.curve[n] = t > 0 ? CurvePoint{other, t} : CurvePoint{};
       return true;
     }

@@ -50,8 +50,8 @@ struct NodeOptOptions {
   //! slide along them, and no node relocates a vertex on them (they keep their shape), as the
   //! paper does for the feature curves in use. Off by default: on organic meshes coarse
   //! tessellation makes many edges "sharp" (spot: 54 nodes on them, E 1.50 → 2.28); on fandisk
-  //! the sharp edges keep their shape (705 before, 712 after, instead of 802 with chamfers) at
-  //! E 11.2 instead of 6.1.
+  //! the sharp edges keep their shape (705 before, 704 after, instead of 802 with chamfers) at
+  //! E 11.4 instead of 6.1.
   bool sharp_edges_as_curves = false;
   //! When a step raises E and some nodes changed their vertex in it, retry the step once with
   //! those nodes kept on their vertices before halving α (the switch itself can raise E).
