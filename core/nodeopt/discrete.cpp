@@ -199,11 +199,7 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
       Candidate c;
       c.layout = layout;
       CurveWalk walk;
-      if (on_curve_step(w)) {
-        walk.vertices = {v, w};
-        for (int x : along)
-          if (x != w) walk.behind = x;
-      }
+      if (on_curve_step(w)) walk = make_curve_walk(*o.curves, {v, w});
       if (!move_node_and_reroute(mesh, c.layout, n, w, o.relocation, context, nullptr,
                                  walk.vertices.empty() ? nullptr : &walk))
         continue;

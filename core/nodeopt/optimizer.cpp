@@ -128,14 +128,25 @@ void emit_step(StepReport r, const TriMesh& mesh, const Layout& layout,
 // The curves nodes slide on (NodeOptOptions::slide_on_curves): the layout's feature edges, the
 // boundary and, with sharp_edges_as_curves, the sharp edges of \p mesh at the field's sharp
 // angle. Empty when off.
-CurveNetwork curve_network(const TriMesh& mesh, const Layout& layout,
+CurveNetwork curve_network(const TriMesh& mesh, const GeometryCache& g, const Layout& layout,
                            const PipelineOptions& options, const NodeOptOptions& no) {
   if (!no.slide_on_curves) return {};
   if (!no.sharp_edges_as_curves) return make_curve_network(mesh, layout, no.curve_corner_deg);
-  const GeometryCache g = build_geometry(mesh);
   const std::vector<char> sharp =
       sharp_edges(mesh, g, options.field.constraints.sharp_angle_deg, nullptr);
   return make_curve_network(mesh, layout, no.curve_corner_deg, &sharp);
+}
+
+}  // namespace
+
+namespace {
+
+// The node is pinned or an end of a pinned arc: it never moves.
+bool held(const Layout& layout, const LayoutNode& node) {
+  if (node.pinned) return true;
+  for (const auto& arc : layout.arcs)
+    if (arc.pinned && (arc.from == node.id || arc.to == node.id)) return true;
+  return false;
 }
 
 }  // namespace
@@ -146,12 +157,9 @@ std::vector<int> movable_nodes(const TriMesh& mesh, const Layout& layout) {
   std::vector<int> out;
   for (int n = 0; n < static_cast<int>(layout.nodes.size()); ++n) {
     const LayoutNode& node = layout.nodes[n];
-    if (node.pinned || feature[node.vertex] || mesh.is_boundary(mesh.vertex_handle(node.vertex)))
-      continue;
-    bool pinned_arc = false;
-    for (const auto& arc : layout.arcs)
-      pinned_arc |= arc.pinned && (arc.from == node.id || arc.to == node.id);
-    if (!pinned_arc) out.push_back(n);
+    if (!feature[node.vertex] && !mesh.is_boundary(mesh.vertex_handle(node.vertex)) &&
+        !held(layout, node))
+      out.push_back(n);
   }
   return out;
 }
@@ -166,11 +174,11 @@ struct NodeOptimizer::Impl {
   NodeOptResult result;
   NodeOptStats counters;
   State state;
-  // Feature and boundary curves (slide_on_curves; empty when off).
-  const CurveNetwork curves;
   std::vector<int> movable;
   const GeometryCache original_geometry;
   const double mean_edge;
+  // Feature and boundary curves (slide_on_curves; empty when off).
+  const CurveNetwork curves;
   Evaluation current;
   // False when current.pipeline was re-solved for a rejected trial (it then holds the trial's
   // positions, not state's).
@@ -210,9 +218,9 @@ struct NodeOptimizer::Impl {
         original(mesh),
         observer(obs),
         state{mesh, layout, {}, std::vector<CurvePoint>(layout.nodes.size())},
-        curves(curve_network(mesh, layout, options_in, no_in)),
         original_geometry(build_geometry(mesh)),
         mean_edge(original_geometry.mean_edge_length),
+        curves(curve_network(mesh, original_geometry, layout, options_in, no_in)),
         reroute(make_reroute_context(mesh, layout)),
         alpha(no_in.alpha),
         step_budget(no_in.max_steps) {
@@ -266,19 +274,12 @@ struct NodeOptimizer::Impl {
   // (slide_on_curves) when not pinned and not an end of a pinned arc. Whether a node slides or
   // moves freely depends on the vertex it is on at each step.
   void compute_movable() {
-    movable.clear();
-    const std::vector<int> free = movable_nodes(original, state.layout);
-    for (int n = 0; n < static_cast<int>(state.layout.nodes.size()); ++n) {
-      const LayoutNode& node = state.layout.nodes[n];
-      if (!on_curve(node.vertex)) {  // movable_nodes' rule
-        if (std::find(free.begin(), free.end(), n) != free.end()) movable.push_back(n);
-        continue;
-      }
-      if (node.pinned) continue;
-      bool pinned_arc = false;
-      for (const auto& arc : state.layout.arcs)
-        pinned_arc |= arc.pinned && (arc.from == node.id || arc.to == node.id);
-      if (!pinned_arc) movable.push_back(n);
+    if (curves.empty()) {
+      movable = movable_nodes(original, state.layout);
+    } else {  // every vertex movable_nodes leaves out (boundary, feature) is on a curve
+      movable.clear();
+      for (int n = 0; n < static_cast<int>(state.layout.nodes.size()); ++n)
+        if (!held(state.layout, state.layout.nodes[n])) movable.push_back(n);
     }
     rejected_target.assign(movable.size(), -1);
     damping.assign(movable.size(), 1.0);
@@ -378,13 +379,12 @@ struct NodeOptimizer::Impl {
         continue;
       if (w != v) {
         const size_t iw = std::find(seq.begin(), seq.end(), w) - seq.begin();
-        CurveWalk walk;  // the curve vertices from v to w
+        std::vector<int> path;  // the curve vertices from v to w
         if (iw >= iv)
-          walk.vertices.assign(seq.begin() + iv, seq.begin() + iw + 1);
+          path.assign(seq.begin() + iv, seq.begin() + iw + 1);
         else
-          for (size_t j = iv + 1; j-- > iw;) walk.vertices.push_back(seq[j]);
-        for (int x : curves.neighbours[v])
-          if (x != walk.vertices[1]) walk.behind = x;
+          for (size_t j = iv + 1; j-- > iw;) path.push_back(seq[j]);
+        const CurveWalk walk = make_curve_walk(curves, std::move(path));
         if (!move_node_and_reroute(trial.mesh, trial.layout, n, w, no.relocation, &reroute,
                                    &obstacles, &walk))
           continue;
@@ -701,10 +701,8 @@ struct NodeOptimizer::Impl {
       target.assign(movable.size(), -1);
       int moved = 0;
       // Arc and node obstacles of the trial layout, kept up to date by each re-routing.
-      LayoutObstacles obstacles = make_layout_obstacles(trial.mesh, trial.layout);
-      // Vertices on sharp features are not relocated for other nodes (paper §6.1.1).
-      for (size_t v = 0; v < curves.neighbours.size(); ++v)
-        if (!curves.neighbours[v].empty()) obstacles.fixed[v] = 1;
+      // Vertices on the curves are not relocated for other nodes (paper §6.1.1).
+      LayoutObstacles obstacles = make_layout_obstacles(trial.mesh, trial.layout, &curves);
       for (size_t i = 0; i < movable.size(); ++i) {
         const int n = movable[i];
         if (on_curve(trial.layout.nodes[n].vertex)) {
@@ -1165,20 +1163,8 @@ const Layout& NodeOptimizer::layout() const {
   return impl_->state.layout;
 }
 
-double NodeOptimizer::energy() const {
-  return impl_->current.E;
-}
-
-int NodeOptimizer::foldovers() const {
-  return impl_->current.foldovers;
-}
-
 const std::vector<StepReport>& NodeOptimizer::reports() const {
   return impl_->result.reports;
-}
-
-bool NodeOptimizer::done() const {
-  return impl_->descent_over;
 }
 
 std::shared_ptr<Pipeline> NodeOptimizer::pipeline(Observer* observer) {

@@ -249,11 +249,8 @@ class NodeOptimizer {
   //! The current (last accepted) state.
   const TriMesh& mesh() const;
   const Layout& layout() const;
-  double energy() const;  //!< E of the current state (unweighted, length²)
-  int foldovers() const;  //!< of the current state's parameterization
   //! Every report so far (the initial solve first).
   const std::vector<StepReport>& reports() const;
-  bool done() const;  //!< step() returned false
   //! The Pipeline solved at the current state (solved again when the last trial, rejected,
   //! re-solved it in place). Valid until the next step(); do not solve it yourself.
   std::shared_ptr<Pipeline> pipeline(Observer* observer = nullptr);

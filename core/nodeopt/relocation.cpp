@@ -104,7 +104,8 @@ std::vector<char> forbidden_relocation_vertices(const TriMesh& mesh, const Layou
   return out;
 }
 
-LayoutObstacles make_layout_obstacles(const TriMesh& mesh, const Layout& layout) {
+LayoutObstacles make_layout_obstacles(const TriMesh& mesh, const Layout& layout,
+                                      const CurveNetwork* curves) {
   LayoutObstacles out;
   out.routing = obstacles_of_layout(mesh, layout);
   out.fixed.assign(mesh.n_vertices(), 0);
@@ -114,6 +115,9 @@ LayoutObstacles make_layout_obstacles(const TriMesh& mesh, const Layout& layout)
     if (a >= 0 && a < static_cast<int>(out.fixed.size())) out.fixed[a] = 1;
     if (b >= 0 && b < static_cast<int>(out.fixed.size())) out.fixed[b] = 1;
   }
+  if (curves && !curves->empty())
+    for (size_t v = 0; v < out.fixed.size(); ++v)
+      if (!curves->neighbours[v].empty()) out.fixed[v] = 1;
   return out;
 }
 
@@ -285,6 +289,14 @@ CurveNetwork make_curve_network(const TriMesh& mesh, const Layout& layout, doubl
     out.slides[v] = (in | on) / (li * lo) >= min_cos;
   }
   return out;
+}
+
+CurveWalk make_curve_walk(const CurveNetwork& curves, std::vector<int> vertices) {
+  CurveWalk walk;
+  for (int x : curves.neighbours[vertices[0]])
+    if (x != vertices[1]) walk.behind = x;
+  walk.vertices = std::move(vertices);
+  return walk;
 }
 
 bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, int new_vertex,

@@ -41,16 +41,39 @@ struct RerouteContext {
 //! Fills a RerouteContext for a valid layout on \p mesh.
 RerouteContext make_reroute_context(const TriMesh& mesh, const Layout& layout);
 
+//! The curves on which nodes slide (paper §6.1.1: "if h lies on a feature curve, we first
+//! project d(h) onto it and restrict the tracing to this curve"): the layout's feature edges,
+//! sharp edges and the mesh boundary.
+struct CurveNetwork {
+  //! Per vertex (size #V): the vertices joined to it by a curve edge.
+  std::vector<std::vector<int>> neighbours;
+  //! Per vertex (size #V): a node here slides along the curve. True when the vertex has exactly
+  //! two curve neighbours and the curve turns there by at most the corner angle (a node on a
+  //! curve's end, a junction or a corner stays).
+  std::vector<char> slides;
+  bool empty() const { return neighbours.empty(); }
+};
+
+//! The curve network of \p layout on \p mesh (original positions); \p corner_deg: the largest
+//! turn of a curve at a vertex on which a node still slides (degrees). \p sharp, when given
+//! (per edge, size #E), marks further feature edges (the sharp edges the cross field aligns to).
+CurveNetwork make_curve_network(const TriMesh& mesh, const Layout& layout, double corner_deg,
+                                const std::vector<char>* sharp = nullptr);
+
 //! Routing state of a layout whose nodes move one at a time (a node optimization trial), kept up
 //! to date by move_node_and_reroute: saves rebuilding the obstacles (O(#F), with an edge look-up
 //! per arc edge) for every moved node and every splice attempt.
 struct LayoutObstacles {
   RoutingObstacles routing;  //!< obstacles_of_layout of the current layout
-  std::vector<char> fixed;   //!< boundary vertices and vertices of feature edges (size #V)
+  //! Vertices never relocated for a node (size #V): boundary vertices, vertices of feature
+  //! edges, and every vertex of the curve network given to make_layout_obstacles.
+  std::vector<char> fixed;
 };
 
-//! The obstacles of \p layout on \p mesh (routing: as obstacles_of_layout).
-LayoutObstacles make_layout_obstacles(const TriMesh& mesh, const Layout& layout);
+//! The obstacles of \p layout on \p mesh (routing: as obstacles_of_layout); \p curves, when
+//! given, adds its vertices to `fixed`.
+LayoutObstacles make_layout_obstacles(const TriMesh& mesh, const Layout& layout,
+                                      const CurveNetwork* curves = nullptr);
 
 //! Number of patches (face components separated by arc edges and the mesh boundary).
 //! \pre every arc path is an edge chain of \p mesh.
@@ -86,31 +109,15 @@ std::vector<char> forbidden_relocation_vertices(const TriMesh& mesh, const Layou
 std::vector<char> forbidden_relocation_vertices(const Layout& layout, int node_index,
                                                 const LayoutObstacles& obstacles);
 
-//! The curves on which nodes slide (paper §6.1.1: "if h lies on a feature curve, we first
-//! project d(h) onto it and restrict the tracing to this curve"): the layout's feature edges,
-//! sharp edges and the mesh boundary.
-struct CurveNetwork {
-  //! Per vertex (size #V): the vertices joined to it by a curve edge.
-  std::vector<std::vector<int>> neighbours;
-  //! Per vertex (size #V): a node here slides along the curve. True when the vertex has exactly
-  //! two curve neighbours and the curve turns there by at most the corner angle (a node on a
-  //! curve's end, a junction or a corner stays).
-  std::vector<char> slides;
-  bool empty() const { return neighbours.empty(); }
-};
-
-//! The curve network of \p layout on \p mesh (original positions); \p corner_deg: the largest
-//! turn of a curve at a vertex on which a node still slides (degrees). \p sharp, when given
-//! (per edge, size #E), marks further feature edges (the sharp edges the cross field aligns to).
-CurveNetwork make_curve_network(const TriMesh& mesh, const Layout& layout, double corner_deg,
-                                const std::vector<char>* sharp = nullptr);
-
 //! A node sliding along a curve to another vertex (move_node_and_reroute).
 struct CurveWalk {
   std::vector<int> vertices;  //!< the curve vertices from the node's vertex to the new one
   //! The old vertex's other curve neighbour (the one the walk turns its back on), or -1.
   int behind = -1;
 };
+
+//! The walk along \p curves through \p vertices (at least two), with its `behind` vertex.
+CurveWalk make_curve_walk(const CurveNetwork& curves, std::vector<int> vertices);
 
 //! Moves node \p node_index of \p layout to \p new_vertex and re-routes its incident arcs: each
 //! arc keeps its old path from k edges after the node on (k = 2, 3, … max_splice_edges; the
