@@ -1,12 +1,16 @@
 // Surfaces with boundary on real meshes (issue #4 item 7): layouts with dangling arcs and
-// trimmed patches on face.obj (one boundary loop) and mask_confmap.obj (three loops).
+// trimmed patches on face.obj (one boundary loop) and mask_confmap.obj (three loops); and
+// boundary-aligned layouts whose corners are not the mesh's corners.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
+#include "core/layout/routing.h"
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_checks.h"
 #include "core/mesh/mesh_io.h"
+#include "core/nodeopt/optimizer.h"
 #include "core/pipeline/pipeline.h"
 #include "tests/fixtures.h"
 
@@ -90,6 +94,129 @@ TEST(Boundary, MaskWithArcsIntoBothEyes) {
   // Free eye holes: a few faces fold where the iso-lines wrap around them (issue #4 note).
   expect_embedding(mesh, layout, 2, /*aligned=*/false, 0.05);
   expect_embedding(mesh, layout, 2, /*aligned=*/true);
+}
+
+// A 2×2 grid aligned with the boundary loop \p loop of a disk: 8 nodes on the boundary loop
+// (corners of valence 2 at loop[0], loop[2s], loop[4s], loop[6s], sides of valence 3 at the odd
+// eighths shifted by \p side_shift loop vertices), one interior node of valence 4 at the centre, 8
+// arcs along the boundary and 4 into the interior.
+Layout loop_grid_layout(const TriMesh& mesh, const std::vector<int>& loop, int side_shift) {
+  const int n = static_cast<int>(loop.size());
+  std::vector<int> at(8);  // loop position of node i
+  for (int i = 0; i < 8; ++i) at[i] = (i * n / 8 + (i % 2 ? side_shift : 0) + n) % n;
+  Layout layout;
+  auto node = [](int id, int vertex) {
+    LayoutNode v;
+    v.id = id;
+    v.vertex = vertex;
+    return v;
+  };
+  auto arc = [](int id, int from, int to, std::vector<int> path) {
+    LayoutArc a;
+    a.id = id;
+    a.from = from;
+    a.to = to;
+    a.path = std::move(path);
+    return a;
+  };
+  for (int i = 0; i < 8; ++i) layout.nodes.push_back(node(i, loop[at[i]]));
+  const int center = nearest_vertex(mesh, centroid(mesh, loop), true);
+  layout.nodes.push_back(node(8, center));
+  for (int i = 0; i < 8; ++i) {  // along the loop from node i to node i + 1
+    std::vector<int> path;
+    for (int k = at[i];; k = (k + 1) % n) {
+      path.push_back(loop[k]);
+      if (k == at[(i + 1) % 8]) break;
+    }
+    layout.arcs.push_back(arc(i, i, (i + 1) % 8, std::move(path)));
+  }
+  for (int i = 1; i < 8; i += 2) {  // centre to the side nodes, inside
+    RoutingObstacles obstacles = obstacles_of_layout(mesh, layout);
+    for (auto v : mesh.vertices())
+      if (mesh.is_boundary(v) && v.idx() != loop[at[i]]) obstacles.vertex_blocked[v.idx()] = 1;
+    layout.arcs.push_back(
+        arc(8 + i / 2, 8, i, shortest_path(mesh, center, loop[at[i]], obstacles)));
+  }
+  return layout;
+}
+
+// The layout's corners need not sit on the mesh's corners: on a flat square whose boundary
+// nodes are shifted along the boundary, the field turns at the corner nodes (boundary
+// singularities) and follows the boundary around the square's corners, so the boundary arcs
+// stay iso-lines and nothing folds. Before the turns were prescribed by the layout
+// (aligned_boundary_turns), a shift of 3 edges gave E 181, 16 fold-overs and no embedding.
+// The boundary loop of the flat 24×24 square disk_grid(24, 24, 2, 2), starting \p shift
+// vertices after the corner at the origin.
+std::vector<int> shifted_square_loop(const TriMesh& mesh, int shift) {
+  std::vector<int> loop = boundary_loops(mesh)[0];
+  auto point = [&](int v) { return mesh.point(mesh.vertex_handle(v)); };
+  int corner = 0;
+  for (size_t k = 0; k < loop.size(); ++k)
+    if (point(loop[k]).norm() < point(loop[corner]).norm()) corner = static_cast<int>(k);
+  const int n = static_cast<int>(loop.size());
+  std::rotate(loop.begin(), loop.begin() + (corner + shift + n) % n, loop.end());
+  return loop;
+}
+
+TEST(Boundary, CornerNodesOffTheMeshCorners) {
+  for (int shift : {0, 3, 6, -5}) {
+    SCOPED_TRACE("shift " + std::to_string(shift));
+    const test::MeshAndLayout d = test::disk_grid(24, 24, 2, 2);
+    const std::vector<int> loop = shifted_square_loop(d.mesh, shift);
+    const Layout layout = loop_grid_layout(d.mesh, loop, shift == -5 ? 2 : 0);
+    ASSERT_TRUE(validate_layout(d.mesh, layout).valid());
+    PipelineOptions options;
+    options.field.constraints.curvature = false;
+    Pipeline pipeline(d.mesh, layout, options);
+    pipeline.compute_field();
+    EXPECT_TRUE(pipeline.singularities().empty());
+    const Parameterization& param = pipeline.compute_parameterization();
+    const Extraction& ex = pipeline.extract();
+    for (const auto& p : ex.problems) ADD_FAILURE() << p;
+    EXPECT_TRUE(ex.structurally_equivalent);
+    EXPECT_EQ(param.foldovers, 0);
+    const test::EmbeddingCheck check = test::check_embedding(
+        pipeline.mesh(), pipeline.geometry(), pipeline.topology(), ex, param.corner_uv);
+    EXPECT_LT(check.iso_violation, 1e-6);
+    EXPECT_LT(check.side_mismatch, 1e-6);
+    EXPECT_EQ(check.sides_checked, 8);
+    // E = 0 exactly when the corners are the square's.
+    if (shift == 0)
+      EXPECT_LT(param.energy, 1e-9);
+    else
+      EXPECT_GT(param.energy, 1e-3);
+    std::printf("[stat] shift %d: E %.6g\n", shift, param.energy);
+  }
+}
+
+// Node optimization of those layouts (issue #5 item 3 on an aligned boundary): the 8 boundary
+// nodes slide along the boundary onto the square's corners and side midpoints, where the
+// layout is exact (E = 0 up to round-off); without sliding they stay and E stays.
+TEST(Boundary, BoundaryNodesSlideOntoTheSquaresCorners) {
+  for (int shift : {3, 6}) {
+    SCOPED_TRACE("shift " + std::to_string(shift));
+    const test::MeshAndLayout d = test::disk_grid(24, 24, 2, 2);
+    const Layout layout = loop_grid_layout(d.mesh, shifted_square_loop(d.mesh, shift), 0);
+    PipelineOptions options;
+    options.field.constraints.curvature = false;
+    NodeOptOptions no;
+    const NodeOptResult r = optimize_nodes(d.mesh, layout, options, no);
+    EXPECT_EQ(r.sliding_nodes, 8);
+    EXPECT_LT(r.E_final, 1e-12 * r.E_init);
+    EXPECT_EQ(r.foldovers_final, 0);
+    for (int i = 0; i < 8; ++i) {  // corners at multiples of 24, side nodes at 12
+      const Vec3 p = d.mesh.point(d.mesh.vertex_handle(r.layout.nodes[i].vertex));
+      const double step = i % 2 ? 12.0 : 24.0;
+      EXPECT_TRUE(d.mesh.is_boundary(d.mesh.vertex_handle(r.layout.nodes[i].vertex)));
+      EXPECT_NEAR(p[0] / step, std::round(p[0] / step), 1e-12) << "node " << i;
+      EXPECT_NEAR(p[1] / step, std::round(p[1] / step), 1e-12) << "node " << i;
+    }
+    no.slide_on_curves = false;
+    const NodeOptResult fixed = optimize_nodes(d.mesh, layout, options, no);
+    EXPECT_GT(fixed.E_final, 0.1 * fixed.E_init);
+    std::printf("[stat] shift %d: E %.6g -> %.3g (sliding), %.6g (not sliding)\n", shift, r.E_init,
+                r.E_final, fixed.E_final);
+  }
 }
 
 }  // namespace

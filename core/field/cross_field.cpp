@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
+#include <climits>
 #include <cmath>
 
 #include "core/base/errors.h"
@@ -73,7 +74,7 @@ void CrossFieldSolver::setup(const TriMesh& mesh, const GeometryCache& g, const 
     for (int v : g.face_vertices[f])
       for (auto f2 : mesh.vf_range(mesh.vertex_handle(v))) carrier_[f2.idx()] = 1;
   }
-  propagate_clusters(mesh, g);
+  propagate_clusters(mesh, g, layout, topology);
   cluster_offset_.assign(field_.clusters, 0);
   cluster_active_.assign(field_.clusters, 1);
   constraint_active_.assign(nc, 1);
@@ -157,10 +158,141 @@ Eigen::VectorXd CrossFieldSolver::back_substitute(const Eigen::VectorXd& b) {
   return solver_.solve(b);
 }
 
-void CrossFieldSolver::propagate_clusters(const TriMesh& mesh, const GeometryCache& g) {
+namespace {
+
+// Quarter turns of the boundary constraints on the boundary loops that layout arcs cover
+// entirely (aligned boundaries, algorithm.md §3.2), as the layout prescribes them.
+//
+// Rounding each constraint against the angle carried to it (propagate_clusters' rule) lets the
+// field follow the tangent through smooth stretches and keep its direction through sharp
+// turns: right when the layout's boundary corners sit on the mesh's corners, wrong otherwise (a
+// corner node on a smooth stretch of face.obj's rim, or an arc around a square's corner, gave
+// E 180–2500 and thousands of fold-overs). The layout fixes it exactly: walking the loop with
+// the interior on the left, the tangent turns against the field by (2 − s)·90° at a node with
+// s interior sectors (s = valence − 1) and not at all elsewhere, so the field turns against the
+// transport by τ − (2 − s)·90° (τ: the boundary's turn at the vertex, its geodesic curvature).
+// Writing the field on each boundary edge as tangent + m·90°, m changes across vertex w by
+// P_w − (2 − s_w), with P_w the period jumps crossed around w: integers, no rounding.
+//
+// Result per constraint: its quarter turn relative to the first constraint of its loop in the
+// walk (INT_MIN off such loops), and the loop's index (-1 off them). A loop whose m does not
+// come back to its start (a layout whose boundary turning contradicts the period jumps) keeps
+// the rounding rule.
+void aligned_boundary_turns(const TriMesh& mesh, const GeometryCache& g, const Layout& layout,
+                            const LayoutTopology& topology, const std::vector<int>& period_jump,
+                            const std::vector<int>& constraint_at, const std::vector<double>& c,
+                            std::vector<int>& preset_q, std::vector<int>& loop_of) {
+  const int nc = static_cast<int>(c.size());
+  preset_q.assign(nc, INT_MIN);
+  loop_of.assign(nc, -1);
+  std::vector<char> on_arc(g.n_edges, 0);
+  for (const auto& arc : layout.arcs)
+    for (size_t k = 0; k + 1 < arc.path.size(); ++k) {
+      const auto h =
+          mesh.find_halfedge(mesh.vertex_handle(arc.path[k]), mesh.vertex_handle(arc.path[k + 1]));
+      if (h.is_valid()) on_arc[mesh.edge_handle(h).idx()] = 1;
+    }
+  std::vector<int> turn(mesh.n_vertices(), 0);  // 2 − s at boundary node vertices
+  for (size_t n = 0; n < layout.nodes.size() && n < topology.valence.size(); ++n) {
+    const auto vh = mesh.vertex_handle(layout.nodes[n].vertex);
+    if (mesh.is_boundary(vh)) turn[vh.idx()] = 2 - (topology.valence[n] - 1);
+  }
+  // Carries angle a from face f across edge e (κ, plus the period jump when with_p).
+  auto carry = [&](double a, int f, int e, bool with_p) {
+    const double step = g.kappa[e] + (with_p ? kQuarter * period_jump[e] : 0.0);
+    return g.edge_face_i[e] == f ? a + step : a - step;
+  };
+  auto wrap = [](double a) { return a - 2 * M_PI * std::round(a / (2 * M_PI)); };
+  std::vector<char> done(mesh.n_halfedges(), 0);
+  int loops = 0;
+  for (auto start : mesh.halfedges()) {
+    // Face-side halfedges of boundary edges: the interior on their left.
+    if (done[start.idx()] || mesh.is_boundary(start) ||
+        !mesh.is_boundary(mesh.opposite_halfedge_handle(start)))
+      continue;
+    std::vector<OpenMesh::SmartHalfedgeHandle> walk;  // the loop in order
+    bool covered = true;
+    for (auto h = start;;) {
+      done[h.idx()] = 1;
+      walk.push_back(h);
+      covered = covered && on_arc[h.edge().idx()];
+      // The next boundary edge at h's end: around to_vertex through the interior faces.
+      auto cur = h;
+      while (!mesh.is_boundary(cur.next().opp())) cur = cur.next().opp();
+      h = cur.next();
+      if (h == start || walk.size() > mesh.n_halfedges()) break;
+    }
+    if (!covered) continue;
+    // m per visited boundary edge: the field is the edge's tangent + m·90° in its face.
+    std::vector<std::pair<int, int>> q;  // (constraint, its quarter turn relative to the start)
+    double phi = 0, tangent = 0;         // field and tangent angles in the current face
+    int face = -1, m = 0;
+    bool ok = true;
+    for (size_t i = 0; i <= walk.size() && ok; ++i) {
+      const auto h = walk[i % walk.size()];
+      const int f = h.face().idx();
+      const Vec3 d = mesh.point(h.to()) - mesh.point(h.from());
+      const double t = g.angle_in_face(f, d);
+      if (face < 0) {
+        m = 0;
+      } else {
+        // Around h.from() from the previous edge's face to f, carrying the field (with p) and
+        // the tangent (without).
+        auto cur = walk[i - 1];
+        int at = face;
+        while (cur.face().idx() != f) {
+          const auto out = cur.next();
+          const int e = out.edge().idx();
+          phi = carry(phi, at, e, true);
+          tangent = carry(tangent, at, e, false);
+          cur = out.opp();
+          at = cur.face().idx();
+          if (cur.is_boundary()) {
+            ok = false;
+            break;
+          }
+        }
+        if (!ok) break;
+        const double tau = wrap(t - tangent);
+        const double next = phi + tau - kQuarter * turn[h.from().idx()];
+        m = static_cast<int>(std::lround((next - t) / kQuarter));
+        if (i == walk.size()) {
+          ok = m == 0;  // back at the start: the loop closes
+          break;
+        }
+      }
+      face = f;
+      tangent = t;
+      phi = t + kQuarter * m;
+      const int k = constraint_at[f];
+      if (k < 0) continue;
+      // The face's constraint follows this edge (a face with two boundary edges follows one).
+      if (std::abs(std::sin(c[k] - t)) > 1e-6) continue;
+      q.push_back({k, static_cast<int>(std::lround((phi - c[k]) / kQuarter))});
+    }
+    if (!ok) continue;
+    for (const auto& [k, qk] : q) {
+      preset_q[k] = qk;
+      loop_of[k] = loops;
+    }
+    ++loops;
+  }
+}
+
+}  // namespace
+
+void CrossFieldSolver::propagate_clusters(const TriMesh& mesh, const GeometryCache& g,
+                                          const Layout& layout, const LayoutTopology& topology) {
   const int nf = g.n_faces;
   const int nc = static_cast<int>(field_.constraints.face.size());
   const std::vector<double> c = constraint_angles(g);
+  std::vector<int> preset_q, loop_of;
+  aligned_boundary_turns(mesh, g, layout, topology, field_.period_jump, constraint_at_, c, preset_q,
+                         loop_of);
+  // Per aligned loop: its presets' offset in the cluster reached first (INT_MIN: not yet).
+  std::vector<int> loop_offset;
+  for (int l : loop_of)
+    if (l >= static_cast<int>(loop_offset.size())) loop_offset.resize(l + 1, INT_MIN);
   cluster_of_.assign(nc, -1);
   relative_q_.assign(nc, 0);
   cluster_size_.clear();
@@ -181,6 +313,11 @@ void CrossFieldSolver::propagate_clusters(const TriMesh& mesh, const GeometryCac
       const int k = constraint_at_[f];
       if (k >= 0) {
         relative_q_[k] = static_cast<int>(std::lround((carried[f] - c[k]) / kQuarter));
+        if (loop_of[k] >= 0) {
+          int& offset = loop_offset[loop_of[k]];
+          if (offset == INT_MIN) offset = relative_q_[k] - preset_q[k];
+          relative_q_[k] = preset_q[k] + offset;
+        }
         carried[f] = c[k] + kQuarter * relative_q_[k];
         cluster_of_[k] = cl;
         ++cluster_size_[cl];
@@ -578,7 +715,7 @@ const CrossField& CrossFieldSolver::update_layout(const TriMesh& mesh, const Geo
   field_.timings.period_jumps_s = seconds_since(t0);
   // Cluster membership depends on the constraint set only; the relative rotations on p.
   const std::vector<int> old_cluster = cluster_of_;
-  propagate_clusters(mesh, g);
+  propagate_clusters(mesh, g, layout, topology);
   if (cluster_of_ != old_cluster)
     throw QsError("internal error: constraint clusters changed in update_layout");
   choose_arc_gauge(mesh, g, layout);

@@ -145,8 +145,11 @@ class CrossFieldSolver {
   std::vector<double> constraint_angles(const GeometryCache& geometry) const;
   void factorize(SpdSolver& solver, const Eigen::SparseMatrix<double>& A);  //!< timed, counted
   Eigen::VectorXd back_substitute(const Eigen::VectorXd& b);
-  //! Relative rotations inside each cluster by propagation over the carrier faces (needs p).
-  void propagate_clusters(const TriMesh& mesh, const GeometryCache& geometry);
+  //! Relative rotations inside each cluster by propagation over the carrier faces (needs p);
+  //! on boundary loops that layout arcs cover, the ones the layout prescribes
+  //! (aligned_boundary_turns).
+  void propagate_clusters(const TriMesh& mesh, const GeometryCache& geometry, const Layout& layout,
+                          const LayoutTopology& topology);
   //! Initial cluster offsets (see ClusterWarmStart); solver_ holds the factorization of matrix_.
   //! Without \p allow_factorization only the relaxed warm start runs (else offsets are kept).
   void warm_start(const GeometryCache& geometry, bool allow_factorization);
