@@ -108,6 +108,7 @@ int main(int argc, char** argv) {
       no.parallel_retry = parallel;
       if (descent_only) {
         no.hop_polish = false;
+        no.stall_gain = 0;  // all STEPS steps, as the 25-step target counts them
         no.orientation_at_end = false;
         no.stiffen_at_end = false;
       }

@@ -14,7 +14,8 @@
 // deficit at its vertex, its relocation offset and the best-fitting vertex within 2 rings.
 // --hop-min-offset X, --hop-candidates N, --hop-max-evaluations N, --hop-max-failures N,
 // --hop-collective 0|1, --hop-cones 0|1, --hop-cone-rings N, --hop-cone-targets N,
-// --hop-cone-max-failures N, --hop-rounds N: NodeOptOptions::hop_* / max_hop_rounds. The
+// --hop-cone-max-failures N, --hop-rounds N, --stall-gain X, --hop-alpha-growth X:
+// NodeOptOptions::hop_* / max_hop_rounds / stall_gain / hop_alpha_growth. The
 // session-4 polish: --hop-cones 0 --hop-collective 0 --hop-min-offset 0.25
 // --hop-max-evaluations 16 --hop-max-failures 0.
 //
@@ -173,6 +174,10 @@ int main(int argc, char** argv) {
       hop.hop_cone_targets = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--hop-cone-max-failures"))
       hop.hop_cone_max_failures = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--stall-gain"))
+      hop.stall_gain = std::atof(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--hop-alpha-growth"))
+      hop.hop_alpha_growth = std::atof(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--hop-rounds"))
       hop.max_hop_rounds = std::atoi(argv[i + 1]);
     else {

@@ -533,6 +533,65 @@ TEST(NodeOptimizer, HopPolishReturnsConsistentState) {
   EXPECT_GT(polished, 0) << "no case exercised the polish";
 }
 
+// After a hop sweep that kept hops, the descent restarts at min(alpha, hop_alpha_growth × the
+// α of the last accepted descent step) (the three rejected steps at 0.75, 0.375 and 0.19 after
+// every sweep on the 8-node layouts are skipped), and at alpha with hop_alpha_growth = 0.
+TEST(NodeOptimizer, DescentAfterHopsRestartsNearTheLastStepSize) {
+  const auto in = test::ellipsoid_example();
+  for (double growth : {2.0, 0.0}) {
+    NodeOptOptions no;
+    no.hop_alpha_growth = growth;
+    no.parallel_hops = false;
+    Recorder rec;
+    const NodeOptResult r = optimize_nodes(in.mesh, in.layout, PipelineOptions{}, no, &rec);
+    int restarts = 0;
+    double last_accepted = 0;
+    for (size_t i = 0; i + 1 < rec.steps.size(); ++i) {
+      const StepReport& s = rec.steps[i];
+      if (s.phase == "descent" && s.accepted) last_accepted = s.step_size;
+      if (s.phase != "hop" || !s.accepted || rec.steps[i + 1].phase != "descent") continue;
+      ASSERT_GT(last_accepted, 0);
+      const double expected = growth > 0 ? std::min(no.alpha, growth * last_accepted) : no.alpha;
+      EXPECT_DOUBLE_EQ(rec.steps[i + 1].step_size, expected);
+      ++restarts;
+    }
+    EXPECT_GT(restarts, 0) << "no hop sweep kept hops";
+    EXPECT_LT(r.E_final, r.E_init);
+    std::printf("[stat] hop_alpha_growth %.0f: E %.6g -> %.6g in %d descent steps\n", growth,
+                r.E_init, r.E_final, r.steps);
+  }
+}
+
+// stall_gain: a descent phase ends (the hop sweep follows) after stall_steps accepted steps in a
+// row with a relative gain below stall_gain, and not before.
+TEST(NodeOptimizer, StalledDescentEndsThePhase) {
+  const auto in = test::ellipsoid_example();
+  NodeOptOptions no;
+  no.stall_gain = 1e-3;
+  no.stall_steps = 2;
+  no.parallel_hops = false;
+  Recorder rec;
+  optimize_nodes(in.mesh, in.layout, PipelineOptions{}, no, &rec);
+  double E = rec.steps.at(0).E;
+  int small = 0, phases_checked = 0;
+  for (const StepReport& s : rec.steps) {
+    if (s.phase == "hop") {
+      if (phases_checked == 0) {  // the first phase ended by the stall rule
+        EXPECT_EQ(small, no.stall_steps);
+      }
+      ++phases_checked;
+      small = 0;
+      if (s.accepted) E = s.E;
+      continue;
+    }
+    if (s.phase != "descent" || !s.accepted) continue;
+    EXPECT_LT(small, no.stall_steps) << "step " << s.step << " ran after the phase stalled";
+    small = E - s.E < no.stall_gain * E ? small + 1 : 0;
+    E = s.E;
+  }
+  EXPECT_GT(phases_checked, 0);
+}
+
 // hop_sweep (the discrete baseline's step and the optimizer's polish): a node displaced by one
 // edge from its exact vertex hops back when its neighbours are tried, E drops to the exact
 // layout's value and the other nodes stay.

@@ -200,6 +200,8 @@ struct NodeOptimizer::Impl {
   std::unique_ptr<State> fewest_folds;
   int fewest_folds_count = 0;
   int phase_halvings = 0;
+  int stalled_steps = 0;      // accepted steps in a row with a gain below stall_gain
+  double accepted_alpha = 0;  // α of the phase's last accepted descent step (0: none yet)
   // Per movable node: the vertex it switched to in the last trial rejected at the current α, or
   // -1 (switch_tabu); and the targets of the trial being built.
   std::vector<int> rejected_target, target;
@@ -640,8 +642,12 @@ struct NodeOptimizer::Impl {
     if (!no.hop_polish || polish_rounds >= no.max_hop_rounds) return false;
     ++polish_rounds;
     if (!hop_round(false)) return false;
-    alpha = no.alpha;
+    alpha = no.hop_alpha_growth > 0 && accepted_alpha > 0
+                ? std::min(no.alpha, no.hop_alpha_growth * accepted_alpha)
+                : no.alpha;
+    accepted_alpha = 0;
     phase_halvings = 0;
+    stalled_steps = 0;
     std::fill(rejected_target.begin(), rejected_target.end(), -1);
     std::fill(damping.begin(), damping.end(), 1.0);
     step_budget = std::max(step_budget, result.steps + no.hop_descent_steps);
@@ -662,7 +668,9 @@ struct NodeOptimizer::Impl {
         if (result.hop_rounds > rounds) return true;
       }
     }
-    if (movable.empty() || result.steps >= step_budget || phase_halvings > no.max_halvings) {
+    const bool stalled = no.stall_gain > 0 && stalled_steps >= no.stall_steps;
+    if (movable.empty() || result.steps >= step_budget || phase_halvings > no.max_halvings ||
+        stalled) {
       if (!movable.empty() && polish()) return true;
       descent_over = true;
       return false;
@@ -899,6 +907,9 @@ struct NodeOptimizer::Impl {
       for (size_t i = 0; i < movable.size(); ++i)
         if (trial.layout.nodes[movable[i]].vertex != state.layout.nodes[movable[i]].vertex)
           damping[i] = 1;
+      const bool small_gain = current.E - next.E < no.stall_gain * current.E;
+      stalled_steps = small_gain ? stalled_steps + 1 : 0;
+      accepted_alpha = alpha;
       note_fold_count(state, next.foldovers);
       state = std::move(trial);
       current = std::move(next);
