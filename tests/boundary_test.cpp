@@ -105,37 +105,23 @@ Layout loop_grid_layout(const TriMesh& mesh, const std::vector<int>& loop, int s
   std::vector<int> at(8);  // loop position of node i
   for (int i = 0; i < 8; ++i) at[i] = (i * n / 8 + (i % 2 ? side_shift : 0) + n) % n;
   Layout layout;
-  auto node = [](int id, int vertex) {
-    LayoutNode v;
-    v.id = id;
-    v.vertex = vertex;
-    return v;
-  };
-  auto arc = [](int id, int from, int to, std::vector<int> path) {
-    LayoutArc a;
-    a.id = id;
-    a.from = from;
-    a.to = to;
-    a.path = std::move(path);
-    return a;
-  };
-  for (int i = 0; i < 8; ++i) layout.nodes.push_back(node(i, loop[at[i]]));
+  for (int i = 0; i < 8; ++i) layout.nodes.push_back(test::make_node(i, loop[at[i]]));
   const int center = nearest_vertex(mesh, centroid(mesh, loop), true);
-  layout.nodes.push_back(node(8, center));
+  layout.nodes.push_back(test::make_node(8, center));
   for (int i = 0; i < 8; ++i) {  // along the loop from node i to node i + 1
     std::vector<int> path;
     for (int k = at[i];; k = (k + 1) % n) {
       path.push_back(loop[k]);
       if (k == at[(i + 1) % 8]) break;
     }
-    layout.arcs.push_back(arc(i, i, (i + 1) % 8, std::move(path)));
+    layout.arcs.push_back(test::make_arc(i, i, (i + 1) % 8, std::move(path)));
   }
   for (int i = 1; i < 8; i += 2) {  // centre to the side nodes, inside
     RoutingObstacles obstacles = obstacles_of_layout(mesh, layout);
     for (auto v : mesh.vertices())
       if (mesh.is_boundary(v) && v.idx() != loop[at[i]]) obstacles.vertex_blocked[v.idx()] = 1;
     layout.arcs.push_back(
-        arc(8 + i / 2, 8, i, shortest_path(mesh, center, loop[at[i]], obstacles)));
+        test::make_arc(8 + i / 2, 8, i, shortest_path(mesh, center, loop[at[i]], obstacles)));
   }
   return layout;
 }

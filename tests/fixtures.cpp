@@ -74,6 +74,8 @@ void add_quad(TriMesh& mesh, int a, int b, int c, int d, bool flip) {
   }
 }
 
+}  // namespace
+
 LayoutNode make_node(int id, int vertex) {
   LayoutNode n;
   n.id = id;
@@ -89,8 +91,6 @@ LayoutArc make_arc(int id, int from, int to, std::vector<int> path) {
   a.path = std::move(path);
   return a;
 }
-
-}  // namespace
 
 MeshAndLayout cube_sphere(int k, Vec3 radii, bool project) {
   MeshAndLayout out;

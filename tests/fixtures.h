@@ -31,6 +31,12 @@ struct MeshAndLayout {
   Layout layout;
 };
 
+//! A layout node with user id \p id on mesh vertex \p vertex (unpinned).
+LayoutNode make_node(int id, int vertex);
+//! A layout arc with user id \p id between node ids \p from and \p to (-1: dangling) along
+//! the vertex path \p path.
+LayoutArc make_arc(int id, int from, int to, std::vector<int> path);
+
 //! Cube split k×k per face (alternating diagonals), projected onto an ellipsoid with the given
 //! radii (radii {1,1,1}: unit sphere; project=false keeps the cube [-1,1]^3). Layout: the 8
 //! cube corners (valence 3) and the 12 cube edges (each a path of k mesh edges): 6 patches.

@@ -65,26 +65,15 @@ SurfacePoint point_near(const TriMesh& mesh, int v) {
 }
 
 LayoutNode node(int id, int vertex) {
-  LayoutNode n;
-  n.id = id;
-  n.vertex = vertex;
-  return n;
+  return test::make_node(id, vertex);
 }
 
 LayoutArc path_arc(int id, int from, int to, std::vector<int> path) {
-  LayoutArc a;
-  a.id = id;
-  a.from = from;
-  a.to = to;
-  a.path = std::move(path);
-  return a;
+  return test::make_arc(id, from, to, std::move(path));
 }
 
 LayoutArc points_arc(int id, int from, int to, std::vector<SurfacePoint> points) {
-  LayoutArc a;
-  a.id = id;
-  a.from = from;
-  a.to = to;
+  LayoutArc a = test::make_arc(id, from, to, {});
   a.points = std::move(points);
   return a;
 }
