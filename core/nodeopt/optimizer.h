@@ -116,8 +116,8 @@ struct NodeOptOptions {
   //! undone at once (hop_collective), sharp cone vertices (hop_cones), then the relocated nodes
   //! (farthest off their vertex first) hop to neighbours (at their original positions) in the
   //! direction of the relocation. When E fell, the state is kept (a step with phase "hop") and
-  //! the descent resumes with α reset. Collective optima (all nodes shifted together, e.g. a
-  //! rotated cube layout on a sphere) are not left this way.
+  //! the descent resumes (at the α hop_alpha_growth sets). Collective optima (all nodes shifted
+  //! together, e.g. a rotated cube layout on a sphere) are not left this way.
   //! Without sharp cone vertices (hop_cones_first then does nothing) the first descent phase is
   //! the same with or without the polish, so it never ends higher.
   //! Callers that drive the descent one step per call (max_steps = 1, the editor) turn it off:
