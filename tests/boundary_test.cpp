@@ -126,11 +126,6 @@ Layout loop_grid_layout(const TriMesh& mesh, const std::vector<int>& loop, int s
   return layout;
 }
 
-// The layout's corners need not sit on the mesh's corners: on a flat square whose boundary
-// nodes are shifted along the boundary, the field turns at the corner nodes (boundary
-// singularities) and follows the boundary around the square's corners, so the boundary arcs
-// stay iso-lines and nothing folds. Before the turns were prescribed by the layout
-// (aligned_boundary_turns), a shift of 3 edges gave E 181, 16 fold-overs and no embedding.
 // The boundary loop of the flat 24×24 square disk_grid(24, 24, 2, 2), starting \p shift
 // vertices after the corner at the origin.
 std::vector<int> shifted_square_loop(const TriMesh& mesh, int shift) {
@@ -144,6 +139,11 @@ std::vector<int> shifted_square_loop(const TriMesh& mesh, int shift) {
   return loop;
 }
 
+// The layout's corners need not sit on the mesh's corners: on a flat square whose boundary
+// nodes are shifted along the boundary, the field turns at the corner nodes (boundary
+// singularities) and follows the boundary around the square's corners, so the boundary arcs
+// stay iso-lines and nothing folds. Before the turns were prescribed by the layout
+// (aligned_boundary_turns), a shift of 3 edges gave E 181, 16 fold-overs and no embedding.
 TEST(Boundary, CornerNodesOffTheMeshCorners) {
   for (int shift : {0, 3, 6, -5}) {
     SCOPED_TRACE("shift " + std::to_string(shift));

@@ -185,13 +185,7 @@ void aligned_boundary_turns(const TriMesh& mesh, const GeometryCache& g, const L
   const int nc = static_cast<int>(c.size());
   preset_q.assign(nc, INT_MIN);
   loop_of.assign(nc, -1);
-  std::vector<char> on_arc(g.n_edges, 0);
-  for (const auto& arc : layout.arcs)
-    for (size_t k = 0; k + 1 < arc.path.size(); ++k) {
-      const auto h =
-          mesh.find_halfedge(mesh.vertex_handle(arc.path[k]), mesh.vertex_handle(arc.path[k + 1]));
-      if (h.is_valid()) on_arc[mesh.edge_handle(h).idx()] = 1;
-    }
+  const std::vector<char> on_arc = arc_edge_mask(mesh, layout);
   std::vector<int> turn(mesh.n_vertices(), 0);  // 2 − s at boundary node vertices
   for (size_t n = 0; n < layout.nodes.size() && n < topology.valence.size(); ++n) {
     const auto vh = mesh.vertex_handle(layout.nodes[n].vertex);

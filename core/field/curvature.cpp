@@ -293,15 +293,8 @@ FieldConstraints collect_constraints(const TriMesh& mesh, const GeometryCache& g
     // Only boundary edges that arcs run along: a boundary crossed by dangling arcs (trimmed
     // patches) is free, and aligning the field to it would force singularities the layout
     // does not have (a disk's boundary turns by 2π).
-    std::vector<char> on_arc(g.n_edges, 0);
-    if (layout) {
-      for (const auto& arc : layout->arcs)
-        for (size_t k = 0; k + 1 < arc.path.size(); ++k) {
-          const auto h = mesh.find_halfedge(mesh.vertex_handle(arc.path[k]),
-                                            mesh.vertex_handle(arc.path[k + 1]));
-          if (h.is_valid()) on_arc[mesh.edge_handle(h).idx()] = 1;
-        }
-    }
+    const std::vector<char> on_arc =
+        layout ? arc_edge_mask(mesh, *layout) : std::vector<char>(g.n_edges, 0);
     for (int e = 0; e < g.n_edges; ++e) {
       if (layout && !on_arc[e]) continue;
       const int f = g.edge_face_i[e] >= 0 && g.edge_face_j[e] < 0   ? g.edge_face_i[e]

@@ -75,6 +75,17 @@ std::vector<HH> outgoing_ccw(const TriMesh& mesh, OpenMesh::VertexHandle v) {
 
 }  // namespace
 
+std::vector<char> arc_edge_mask(const TriMesh& mesh, const Layout& layout) {
+  std::vector<char> mask(mesh.n_edges(), 0);
+  for (const LayoutArc& arc : layout.arcs)
+    for (size_t k = 0; k + 1 < arc.path.size(); ++k) {
+      const auto h =
+          mesh.find_halfedge(mesh.vertex_handle(arc.path[k]), mesh.vertex_handle(arc.path[k + 1]));
+      if (h.is_valid()) mask[mesh.edge_handle(h).idx()] = 1;
+    }
+  return mask;
+}
+
 LayoutTopology build_topology(const TriMesh& mesh, const Layout& layout) {
   LayoutTopology topo;
   const int n_nodes = static_cast<int>(layout.nodes.size());

@@ -108,6 +108,10 @@ inline int sigma(int h) {
   return h ^ 1;
 }
 
+//! Per mesh edge (size #E): 1 when an arc's path runs along it. Path steps that are not mesh
+//! edges are skipped.
+std::vector<char> arc_edge_mask(const TriMesh& mesh, const Layout& layout);
+
 //! Builds the rotation system and patches of a layout whose paths are valid (see
 //! validate_layout; call it on layouts with no errors only).
 //! \pre every arc has a path of mesh edges between its end vertices; arcs are disjoint.

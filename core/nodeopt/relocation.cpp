@@ -199,15 +199,9 @@ std::vector<int> rotation_at(const TriMesh& mesh, const Layout& layout, int n) {
 }  // namespace
 
 int count_patches(const TriMesh& mesh, const Layout& layout) {
-  std::vector<char> wall(mesh.n_edges(), 0);
+  std::vector<char> wall = arc_edge_mask(mesh, layout);
   for (auto e : mesh.edges())
     if (mesh.is_boundary(e)) wall[e.idx()] = 1;
-  for (const LayoutArc& arc : layout.arcs)
-    for (size_t k = 0; k + 1 < arc.path.size(); ++k) {
-      const HH h =
-          mesh.find_halfedge(mesh.vertex_handle(arc.path[k]), mesh.vertex_handle(arc.path[k + 1]));
-      if (h.is_valid()) wall[mesh.edge_handle(h).idx()] = 1;
-    }
   std::vector<char> seen(mesh.n_faces(), 0);
   std::vector<int> stack;
   int patches = 0;

@@ -341,12 +341,7 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
   // Explicit feature edges (layout "features") that are not arcs: iso-lines of the field's
   // matching parameter.
   {
-    std::vector<char> arc_edge(g.n_edges, 0);
-    for (const auto& arc : layout.arcs)
-      for (size_t k = 0; k + 1 < arc.path.size(); ++k)
-        arc_edge[mesh.edge_handle(mesh.find_halfedge(mesh.vertex_handle(arc.path[k]),
-                                                     mesh.vertex_handle(arc.path[k + 1])))
-                     .idx()] = 1;
+    const std::vector<char> arc_edge = arc_edge_mask(mesh, layout);
     for (const auto& [a, b] : layout.feature_edges) {
       auto h = mesh.find_halfedge(mesh.vertex_handle(a), mesh.vertex_handle(b));
       if (!h.is_valid() || arc_edge[mesh.edge_handle(h).idx()]) continue;
