@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/layout/quad_import.h"
 #include "core/layout/routing.h"
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_checks.h"
@@ -203,6 +204,68 @@ TEST(Boundary, BoundaryNodesSlideOntoTheSquaresCorners) {
     std::printf("[stat] shift %d: E %.6g -> %.3g (sliding), %.6g (not sliding)\n", shift, r.E_init,
                 r.E_final, fixed.E_final);
   }
+}
+
+// A boundary-aligned layout on a real model (issue #4 item 7, issue #5): the base complex of
+// libigl's conjugate-field quad mesh of inspired_mesh, coarsened to 15 nodes and routed onto
+// the triangle mesh. Its iso-lines meet the rectangular boundary at about 45°, so the layout's
+// corners (valence-2 nodes) sit on straight boundary, the rectangle's corners lie inside
+// boundary arcs, and the parameterization with the imported node positions folds. The full
+// optimization (descent, boundary nodes sliding, fold-over removal) must embed it.
+TEST(Boundary, InspiredMeshQuadLayoutEmbedsAfterOptimization) {
+  const std::string dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes is absent (real-mesh test)";
+  const PolyMesh quads = load_poly_mesh(dir + "/inspired_mesh/inspired_mesh_quads_Conjugate.off");
+  const TriMesh target = load_mesh(dir + "/inspired_mesh/inspired_mesh.obj");
+  QuadImportOptions io;
+  io.coarsen = 16;
+  const QuadImportResult in = import_quads(quads, &target, io);
+  ASSERT_TRUE(validate_layout(in.mesh, in.layout).valid());
+  // Boundary-aligned: arcs cover the whole boundary loop.
+  auto boundary_covered = [](const TriMesh& mesh, const Layout& layout) {
+    const std::vector<char> on_arc = arc_edge_mask(mesh, layout);
+    for (auto e : mesh.edges())
+      if (mesh.is_boundary(e) && !on_arc[e.idx()]) return false;
+    return true;
+  };
+  ASSERT_EQ(boundary_loops(in.mesh).size(), 1u);
+  ASSERT_TRUE(boundary_covered(in.mesh, in.layout));
+  std::vector<char> on_boundary(in.layout.nodes.size());
+  int boundary_nodes = 0;
+  for (size_t n = 0; n < in.layout.nodes.size(); ++n) {
+    on_boundary[n] = in.mesh.is_boundary(in.mesh.vertex_handle(in.layout.nodes[n].vertex));
+    boundary_nodes += on_boundary[n];
+  }
+  ASSERT_GT(boundary_nodes, 4);
+
+  const NodeOptResult r = optimize_nodes(in.mesh, in.layout, PipelineOptions{}, NodeOptOptions{});
+  EXPECT_GT(r.foldovers_init, 0) << "the imported node positions should fold (the case's point)";
+  EXPECT_LT(r.E_final, r.E_init);
+  EXPECT_EQ(r.foldovers_final, 0);
+  EXPECT_GT(r.sliding_nodes, 0);
+  for (size_t n = 0; n < r.layout.nodes.size(); ++n)
+    EXPECT_EQ(r.mesh.is_boundary(r.mesh.vertex_handle(r.layout.nodes[n].vertex)),
+              static_cast<bool>(on_boundary[n]))
+        << "node " << n << " left or reached the boundary";
+  EXPECT_TRUE(boundary_covered(r.mesh, r.layout));
+  EXPECT_TRUE(validate_layout(r.mesh, r.layout).valid());
+  ASSERT_TRUE(r.pipeline);
+  Pipeline& final_solve = *r.pipeline;
+  const Extraction& ex = final_solve.extract();
+  for (const auto& p : ex.problems) ADD_FAILURE() << p;
+  EXPECT_TRUE(ex.structurally_equivalent);
+  EXPECT_EQ(ex.bad_cones, 0);
+  const test::EmbeddingCheck check =
+      test::check_embedding(final_solve.mesh(), final_solve.geometry(), final_solve.topology(), ex,
+                            final_solve.parameterization()->corner_uv);
+  EXPECT_LT(check.iso_violation, 1e-6);
+  EXPECT_LT(check.side_mismatch, 1e-6);
+  EXPECT_GT(check.sides_checked, 0);
+  std::printf(
+      "[stat] inspired_mesh --coarsen 16: %zu nodes (%d on the boundary, %d sliding), E %.6g -> "
+      "%.6g, fold-overs %d -> %d (descent) -> %d, %d steps, %d hops\n",
+      r.layout.nodes.size(), boundary_nodes, r.sliding_nodes, r.E_init, r.E_final, r.foldovers_init,
+      r.foldovers_descent, r.foldovers_final, r.steps, r.hops);
 }
 
 }  // namespace

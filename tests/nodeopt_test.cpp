@@ -562,6 +562,36 @@ TEST(NodeOptimizer, DescentAfterHopsRestartsNearTheLastStepSize) {
   }
 }
 
+// reuse_hop_solve: a sweep that kept hops takes its best candidate's solve as the new state
+// instead of solving that state again: the same trajectory (every reported E bit for bit), one
+// re-layout less per such sweep, with and without the second thread.
+TEST(NodeOptimizer, HopSweepKeepsItsBestCandidatesSolve) {
+  const auto in = test::ellipsoid_example();
+  for (bool parallel : {false, true}) {
+    SCOPED_TRACE(parallel ? "parallel hops" : "one at a time");
+    std::vector<double> E[2];
+    NodeOptStats stats[2];
+    int kept_sweeps = 0;
+    for (int reuse = 0; reuse < 2; ++reuse) {
+      NodeOptOptions no;
+      no.parallel_hops = parallel;
+      no.reuse_hop_solve = reuse != 0;
+      Recorder rec;
+      const NodeOptResult r =
+          optimize_nodes(in.mesh, in.layout, PipelineOptions{}, no, &rec, nullptr, &stats[reuse]);
+      for (const StepReport& s : rec.steps) E[reuse].push_back(s.E);
+      E[reuse].push_back(r.E_final);
+      if (reuse)
+        for (const StepReport& s : rec.steps) kept_sweeps += s.phase == "hop" && s.accepted;
+    }
+    ASSERT_GT(kept_sweeps, 0) << "no sweep kept hops";
+    EXPECT_EQ(E[1], E[0]);
+    EXPECT_EQ(stats[0].reused_hop_solves, 0);
+    EXPECT_EQ(stats[1].reused_hop_solves, kept_sweeps);
+    EXPECT_EQ(stats[0].relayouts - stats[1].relayouts, kept_sweeps);
+  }
+}
+
 // stall_gain: a descent phase ends (the hop sweep follows) after stall_steps accepted steps in a
 // row with a relative gain below stall_gain, and not before.
 TEST(NodeOptimizer, StalledDescentEndsThePhase) {

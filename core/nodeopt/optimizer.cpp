@@ -7,6 +7,7 @@
 #include <exception>
 #include <future>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <thread>
 
@@ -445,8 +446,23 @@ struct NodeOptimizer::Impl {
   bool hop_round(bool cones_only) {
     const auto t_hop = std::chrono::steady_clock::now();
     check_cancel(observer);
+    // The solved candidate with the lowest E so far (a job may run on the second thread): the
+    // sweep's final state is usually one of them, and then needs no second solve at the end.
+    std::mutex best_mutex;
+    Evaluation best;
+    auto keep_if_best = [&](Evaluation ev) {
+      if (!no.reuse_hop_solve) return;
+      std::lock_guard<std::mutex> lock(best_mutex);
+      if (!best.pipeline || ev.E < best.E) best = std::move(ev);
+    };
     const HopEvaluator evaluate = [&](const TriMesh& m, const Layout& l, double& E, int& folds) {
-      return measured([&] { return evaluate_switched(m, l); }, E, folds);
+      return measured(
+          [&] {
+            Evaluation ev = evaluate_switched(m, l);
+            keep_if_best(ev);
+            return ev;
+          },
+          E, folds);
     };
     // Two at a time (parallel_hops): each job's Pipeline is built here and owns its
     // factorizations before any thread solves it.
@@ -459,12 +475,13 @@ struct NodeOptimizer::Impl {
         return [](double&, int&) { return false; };
       }
       const PipelineOptions* opts = &options;
-      return [p, opts](double& E, int& folds) {
+      return [p, opts, &keep_if_best](double& E, int& folds) {
         return measured(
             [&] {
               Evaluation ev;
               ev.pipeline = p;
               solve_and_measure(ev, *opts);
+              keep_if_best(ev);
               return ev;
             },
             E, folds);
@@ -612,7 +629,16 @@ struct NodeOptimizer::Impl {
         }
       }
       check_cancel(observer);
-      Evaluation next = evaluate_switched(hopped.mesh, hopped.layout);
+      // The kept candidate's own solve when it is the best one solved (always, unless a
+      // discarded parallel solve was lower); otherwise the state is solved again.
+      Evaluation next;
+      if (no.reuse_hop_solve && best.pipeline && best.E == h.E &&
+          pipeline_matches(*best.pipeline, hopped.mesh, hopped.layout)) {
+        next = std::move(best);
+        ++counters.reused_hop_solves;
+      } else {
+        next = evaluate_switched(hopped.mesh, hopped.layout);
+      }
       if (next.E <= current.E) {  // equal to h.E: the same deterministic solve
         if (!pre_polish) pre_polish = std::make_unique<State>(state);
         note_fold_count(state, next.foldovers);

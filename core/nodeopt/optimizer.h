@@ -143,6 +143,10 @@ struct NodeOptOptions {
   //! continued Pipeline copies its field factorizations (Pipeline::unshare_solvers) before it
   //! is solved. Same candidates, same kept moves, same result as one at a time.
   bool parallel_hops = true;
+  //! A sweep's final state is taken with its best candidate's solve (the same deterministic
+  //! solve) instead of being solved once more; false: solved again (same result, one solve
+  //! more per sweep that kept hops).
+  bool reuse_hop_solve = true;
   //! When fold-overs remain after the descent and the polish kept hops, the state before the
   //! polish (the first fallback of the fold-over removal) is solved and oriented on a second
   //! thread while the final state is oriented, on machines with two hardware threads. Its
@@ -230,6 +234,7 @@ struct NodeOptStats {
   int tabu_steps = 0;          //!< trials rejected as repeated switches (switch_tabu)
   int parallel_retries = 0;    //!< re-layouts solved beside their retry (parallel_retry)
   int parallel_hop_jobs = 0;   //!< hop candidates prepared for a two-at-a-time solve
+  int reused_hop_solves = 0;   //!< sweeps whose kept state was its best candidate's solve
   int parallel_fallbacks = 0;  //!< speculative fallback solves that were used (parallel_fallback)
   bool warm_start = false;     //!< the given start Pipeline served as the initial solve
 };
