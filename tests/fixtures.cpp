@@ -29,6 +29,25 @@ std::string shared_meshes_dir() {
   return std::filesystem::is_directory(p) ? p.string() : std::string();
 }
 
+CageOptions fertility_cage_options() {
+  CageOptions options;
+  options.resolution = 30;
+  options.shift = 0.5;
+  options.attempts = 1;
+  options.subsamples = 4;
+  options.coarsen = 10;
+  options.max_refine = 2;
+  return options;
+}
+
+CageOptions fertility_simplified_cage_options() {
+  CageOptions options = fertility_cage_options();
+  options.resolution = 34;
+  options.shift = 0;
+  options.simplify = true;
+  return options;
+}
+
 std::string assets_dir() {
   return QS_ASSETS_DIR;
 }

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/extract/tracing.h"
+#include "core/layout/cage.h"
 #include "core/layout/layout.h"
 #include "core/mesh/geometry.h"
 #include "core/mesh/mesh.h"
@@ -16,6 +17,15 @@ namespace qs::test {
 
 //! Folder with the shared real meshes (../shared/data/meshes), or "" when it is absent.
 std::string shared_meshes_dir();
+
+//! The cage options that give fertility.obj (genus 4, 27954 faces) its layout: cells of 1/30
+//! of the longest axis (6.6 units; the thinnest parts are 7 units thick, the narrowest gaps 3.4
+//! units wide, the mean edge 2.2), classified by their inside fraction, grid shifted by half a
+//! cell, chords up to 10 cells collapsed, the fitted cage split twice before the transfer.
+CageOptions fertility_cage_options();
+//! The same with CageOptions::simplify at resolution 34, unshifted (the coarsened cage's nearby
+//! irregular vertices cancelled; without simplify no grid at 34 transfers).
+CageOptions fertility_simplified_cage_options();
 //! The repository's assets/ folder.
 std::string assets_dir();
 //! Path of the quadsketch-cli executable.
