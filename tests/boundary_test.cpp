@@ -162,8 +162,7 @@ TEST(Boundary, CornerNodesOffTheMeshCorners) {
     for (const auto& p : ex.problems) ADD_FAILURE() << p;
     EXPECT_TRUE(ex.structurally_equivalent);
     EXPECT_EQ(param.foldovers, 0);
-    const test::EmbeddingCheck check = test::check_embedding(
-        pipeline.mesh(), pipeline.geometry(), pipeline.topology(), ex, param.corner_uv);
+    const test::EmbeddingCheck check = test::check_embedding(pipeline);
     EXPECT_LT(check.iso_violation, 1e-6);
     EXPECT_LT(check.side_mismatch, 1e-6);
     EXPECT_EQ(check.sides_checked, 8);
@@ -255,9 +254,7 @@ TEST(Boundary, InspiredMeshQuadLayoutEmbedsAfterOptimization) {
   for (const auto& p : ex.problems) ADD_FAILURE() << p;
   EXPECT_TRUE(ex.structurally_equivalent);
   EXPECT_EQ(ex.bad_cones, 0);
-  const test::EmbeddingCheck check =
-      test::check_embedding(final_solve.mesh(), final_solve.geometry(), final_solve.topology(), ex,
-                            final_solve.parameterization()->corner_uv);
+  const test::EmbeddingCheck check = test::check_embedding(final_solve);
   EXPECT_LT(check.iso_violation, 1e-6);
   EXPECT_LT(check.side_mismatch, 1e-6);
   EXPECT_GT(check.sides_checked, 0);

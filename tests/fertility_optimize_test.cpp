@@ -2,8 +2,8 @@
 // hop polish, fold-over removal) embeds a layout on it. The layout is the simplified voxel-cage
 // layout (test::fertility_simplified_cage_options, generated from ../shared; nothing derived
 // from the model is shipped): with its imported node positions the parameterization folds and
-// is not structurally equivalent (fertility_test.cpp). About two and a half minutes in a
-// Release build, so the sanitizer CI leaves it out (label "slow", tests/CMakeLists.txt).
+// is not structurally equivalent (fertility_test.cpp). About two minutes in a Release build, so
+// the sanitizer CI leaves it out (label "slow", tests/CMakeLists.txt).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -40,9 +40,7 @@ TEST(FertilityOptimize, SimplifiedCageLayoutEmbedsAfterNodeOptimization) {
   EXPECT_TRUE(ex.structurally_equivalent);
   EXPECT_EQ(ex.bad_cones, 0);
   EXPECT_EQ(ex.patch_size.size(), patches);
-  const test::EmbeddingCheck check =
-      test::check_embedding(final_solve.mesh(), final_solve.geometry(), final_solve.topology(), ex,
-                            final_solve.parameterization()->corner_uv);
+  const test::EmbeddingCheck check = test::check_embedding(final_solve);
   EXPECT_LT(check.iso_violation, 1e-6) << "iso-line violation";
   EXPECT_LT(check.side_mismatch, 1e-6) << "opposite patch sides differ";
   EXPECT_GT(check.sides_checked, 0);

@@ -148,8 +148,7 @@ TEST(Fertility, DISABLED_ParameterizationEmbedsTheLayout) {
   for (size_t i = 0; i < ex.problems.size() && i < 5; ++i) ADD_FAILURE() << ex.problems[i];
   EXPECT_TRUE(ex.structurally_equivalent);
   EXPECT_EQ(ex.patch_size.size(), pipeline.topology().patches.size());
-  const test::EmbeddingCheck check = test::check_embedding(
-      pipeline.mesh(), pipeline.geometry(), pipeline.topology(), ex, param.corner_uv);
+  const test::EmbeddingCheck check = test::check_embedding(pipeline);
   EXPECT_LT(check.iso_violation, 1e-6) << "iso-line violation";
   EXPECT_LT(check.side_mismatch, 1e-6) << "opposite patch sides differ";
   EXPECT_GT(check.sides_checked, 0);

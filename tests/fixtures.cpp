@@ -621,6 +621,12 @@ EmbeddingCheck check_embedding(const TriMesh& mesh, const GeometryCache& geometr
   return check;
 }
 
+EmbeddingCheck check_embedding(Pipeline& pipeline) {
+  const Extraction& ex = pipeline.extract();
+  return check_embedding(pipeline.mesh(), pipeline.geometry(), pipeline.topology(), ex,
+                         pipeline.parameterization()->corner_uv);
+}
+
 Layout displace_nodes(const TriMesh& mesh, Layout layout, int rings, int seed) {
   for (int n = 0; n < static_cast<int>(layout.nodes.size()); ++n) {
     if (layout.nodes[n].pinned) continue;

@@ -159,6 +159,9 @@ struct EmbeddingCheck {
 EmbeddingCheck check_embedding(const TriMesh& mesh, const GeometryCache& geometry,
                                const LayoutTopology& topology, const Extraction& extraction,
                                const std::vector<std::array<double, 2>>& corner_uv);
+//! The same for a solved Pipeline: its extraction (extract(), run if needed) and its
+//! parameterization's corner_uv. \pre compute_parameterization() has run.
+EmbeddingCheck check_embedding(Pipeline& pipeline);
 
 //! The vertices at exactly \p rings edge hops from vertex \p v (breadth-first search).
 std::vector<int> ring_vertices(const TriMesh& mesh, int v, int rings);
