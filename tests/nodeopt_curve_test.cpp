@@ -274,5 +274,38 @@ TEST(CurveSliding, CornersAndJunctionsStay) {
   EXPECT_EQ(curves.neighbours[grid_vertex(nx, 6, 0)].size(), 3u);
 }
 
+// The carrying vertex of a node that slid along a curve segment (the optimizer's rule for sliding
+// nodes): the nearer end first, at the point itself; the farther end at most at the middle; an
+// end that does not slide only at its own place; an occupied end not at all.
+TEST(CurveSliding, CarrierOfASlidNodeFollowsTheSegmentRules) {
+  // Vertices 0 and 1 slide, 2 is a corner (does not slide).
+  const std::vector<char> slides = {1, 1, 0};
+  auto any = [](int) { return true; };
+  auto pairs = [](const std::vector<CurveCarrier>& c) {
+    std::vector<std::pair<int, double>> out;
+    for (const CurveCarrier& x : c) out.push_back({x.vertex, x.fraction});
+    return out;
+  };
+  using P = std::vector<std::pair<int, double>>;
+  // Both ends slide: the nearer carries to the point, the farther to the middle.
+  EXPECT_EQ(pairs(curve_carriers(0, 1, 0.3, 0, slides, any)), (P{{0, 0.3}, {1, 0.5}}));
+  EXPECT_EQ(pairs(curve_carriers(0, 1, 0.8, 0, slides, any)), (P{{1, 0.8}, {0, 0.5}}));
+  // Stopped just short of the corner 2: the corner cannot carry the node there, so the node's
+  // own vertex does, capped at the middle (not at 0.9, which would squeeze its faces).
+  EXPECT_EQ(pairs(curve_carriers(0, 2, 0.9, 0, slides, any)), (P{{0, 0.5}}));
+  // On the corner itself the corner carries it (at its own place), else the middle.
+  EXPECT_EQ(pairs(curve_carriers(0, 2, 1.0, 0, slides, any)), (P{{2, 1.0}, {0, 0.5}}));
+  // Segment (corner, node vertex): the corner carries only at fraction 0.
+  EXPECT_EQ(pairs(curve_carriers(2, 1, 0.2, 1, slides, any)), (P{{1, 0.5}}));
+  EXPECT_EQ(pairs(curve_carriers(2, 1, 0.0, 1, slides, any)), (P{{2, 0.0}, {1, 0.5}}));
+  // An end that may not be taken (another node or arc there) is skipped; the node's own vertex
+  // is never skipped.
+  auto not_1 = [](int w) { return w != 1; };
+  EXPECT_EQ(pairs(curve_carriers(0, 1, 0.8, 0, slides, not_1)), (P{{0, 0.5}}));
+  auto none = [](int) { return false; };
+  EXPECT_EQ(pairs(curve_carriers(0, 1, 0.3, 0, slides, none)), (P{{0, 0.3}}));
+  EXPECT_EQ(pairs(curve_carriers(0, 1, 0.3, 1, slides, none)), (P{{1, 0.5}}));
+}
+
 }  // namespace
 }  // namespace qs

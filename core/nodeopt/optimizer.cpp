@@ -362,21 +362,15 @@ struct NodeOptimizer::Impl {
       const double seg = (point(seq[1]) - point(seq[0])).norm();
       if (seg <= 0 || (start - point(seq[0])).norm() >= 0.5 * seg) return false;
     }
-    const Vec3 goal = s >= 1   ? point(seq[k + 1])
-                      : s <= 0 ? point(seq[k])
-                               : point(seq[k]) + s * (point(seq[k + 1]) - point(seq[k]));
-    // The carrying vertex: the nearer end of the segment that may carry the node.
-    const std::vector<int> ends =
-        s <= 0.5 ? std::vector<int>{seq[k], seq[k + 1]} : std::vector<int>{seq[k + 1], seq[k]};
     const size_t iv = std::find(seq.begin(), seq.end(), v) - seq.begin();
-    const Vec3 middle = 0.5 * (point(seq[k]) + point(seq[k + 1]));
-    for (int w : ends) {
-      if (w != v && (no_switch || occupied(w))) continue;
-      // A vertex that does not slide only carries the node at its own place.
-      if (!curves.slides[w] && (goal - point(w)).norm() > 0) continue;
-      // The farther end carries the node at most to the segment's middle: a vertex relocated
-      // further along the curve would squeeze its faces on the other side.
-      const Vec3 at = w == ends[0] ? goal : middle;
+    const std::vector<CurveCarrier> carriers = curve_carriers(
+        seq[k], seq[k + 1], s, v, curves.slides, [&](int w) { return !no_switch && !occupied(w); });
+    for (const CurveCarrier& carrier : carriers) {
+      const int w = carrier.vertex;
+      const double f = carrier.fraction;
+      const Vec3 at = f <= 0   ? point(seq[k])
+                      : f >= 1 ? point(seq[k + 1])
+                               : point(seq[k]) + f * (point(seq[k + 1]) - point(seq[k]));
       if (!relocation_keeps_orientation(trial.mesh, original, w == v ? -1 : v, w, at,
                                         no.relocation))
         continue;
@@ -397,8 +391,7 @@ struct NodeOptimizer::Impl {
       }
       trial.mesh.set_point(trial.mesh.vertex_handle(w), at);
       const int other = w == seq[k] ? seq[k + 1] : seq[k];
-      const double sw = w == ends[0] ? s : 0.5;  // the fraction carried, from seq[k]
-      const double t = w == seq[k] ? sw : 1 - sw;
+      const double t = w == seq[k] ? carrier.fraction : 1 - carrier.fraction;
       trial.curve[n] = t > 0 ? CurvePoint{other, t} : CurvePoint{};
       return true;
     }

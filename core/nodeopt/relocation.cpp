@@ -1,6 +1,7 @@
 #include "core/nodeopt/relocation.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "core/layout/routing.h"
@@ -291,6 +292,22 @@ CurveWalk make_curve_walk(const CurveNetwork& curves, std::vector<int> vertices)
     if (x != vertices[1]) walk.behind = x;
   walk.vertices = std::move(vertices);
   return walk;
+}
+
+std::vector<CurveCarrier> curve_carriers(int a, int b, double s, int node_vertex,
+                                         const std::vector<char>& slides,
+                                         const std::function<bool(int)>& may_take) {
+  std::vector<CurveCarrier> out;
+  const bool b_nearer = s > 0.5;
+  for (int w : b_nearer ? std::array<int, 2>{b, a} : std::array<int, 2>{a, b}) {
+    if (w != node_vertex && !may_take(w)) continue;
+    const bool nearer = (w == b) == b_nearer;
+    const double fraction = nearer ? s : 0.5;
+    const bool at_own_place = w == a ? fraction <= 0 : fraction >= 1;
+    if (!slides[w] && !at_own_place) continue;
+    out.push_back({w, fraction});
+  }
+  return out;
 }
 
 bool move_node_and_reroute(const TriMesh& mesh, Layout& layout, int node_index, int new_vertex,

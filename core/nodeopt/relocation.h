@@ -2,6 +2,7 @@
 // (paper §6.1.1, algorithm.md §6.4).
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include "core/layout/layout.h"
@@ -118,6 +119,23 @@ struct CurveWalk {
 
 //! The walk along \p curves through \p vertices (at least two), with its `behind` vertex.
 CurveWalk make_curve_walk(const CurveNetwork& curves, std::vector<int> vertices);
+
+//! A vertex that may carry a node sliding along a curve segment, and where to.
+struct CurveCarrier {
+  int vertex = -1;        //!< the carrying vertex (an end of the segment)
+  double fraction = 0.0;  //!< its new position: this fraction of the segment from its end a
+};
+
+//! The vertices that may carry a node which slid to fraction \p s ∈ [0, 1] of the curve segment
+//! (\p a, \p b), in the order to try them: the nearer end first, carrying the node to the point
+//! itself, then the farther end, carrying it at most to the segment's middle (relocated further
+//! along the curve, it would squeeze its faces on the other side). An end other than
+//! \p node_vertex is left out when \p may_take is false for it; an end that does not slide
+//! (\p slides, size #V: a curve end, junction or corner) only carries the node at its own place
+//! (s = 0 for a, s = 1 for b). Whether a relocation keeps the orientation is left to the caller.
+std::vector<CurveCarrier> curve_carriers(int a, int b, double s, int node_vertex,
+                                         const std::vector<char>& slides,
+                                         const std::function<bool(int)>& may_take);
 
 //! Moves node \p node_index of \p layout to \p new_vertex and re-routes its incident arcs: each
 //! arc keeps its old path from k edges after the node on (k = 2, 3, … max_splice_edges; the
