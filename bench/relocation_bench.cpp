@@ -5,6 +5,7 @@
 // continuous run first reaches the discrete run's final E. Not a test.
 //
 //   qs_relocation_bench [--rings K] [--seeds N] [--max-steps S] [--case NAME] [--hop-all]
+//   [--gradient exact]
 //                       [--no-discrete] [--verbose] [--hop-OPTION VALUE ...]
 //
 // --hop-all: the continuous run's hop polish tries every neighbour of every relocated node (no
@@ -178,12 +179,15 @@ int main(int argc, char** argv) {
       hop.stall_gain = std::atof(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--hop-alpha-growth"))
       hop.hop_alpha_growth = std::atof(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--gradient"))
+      hop.gradient = !std::strcmp(argv[i + 1], "exact") ? qs::GradientMethod::Exact
+                                                        : qs::GradientMethod::Estimator;
     else if (!std::strcmp(argv[i], "--hop-rounds"))
       hop.max_hop_rounds = std::atoi(argv[i + 1]);
     else {
       std::fprintf(stderr,
                    "usage: qs_relocation_bench [--rings K] [--seeds N] [--max-steps S] "
-                   "[--case NAME] [--hop-all] [--no-discrete] [--verbose] "
+                   "[--case NAME] [--hop-all] [--no-discrete] [--verbose] [--gradient exact] "
                    "[--hop-OPTION VALUE ...]\n");
       return 2;
     }

@@ -8,6 +8,7 @@
 #include <limits>
 #include <queue>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 #include <utility>
 
@@ -37,9 +38,13 @@ std::string format_double(double d) {
 //! Dijkstra over mesh edges from \p source, never entering blocked vertices (except a vertex
 //! for which \p is_target holds) or crossing blocked edges. Stops at the first settled vertex
 //! for which \p is_target holds and returns the vertex path to it (empty when none is
-//! reachable). The source itself is never a target.
+//! reachable). The source itself is never a target. With \p goal (the position of the only
+//! target vertex), the search is A*: vertices are settled in the order of their distance plus
+//! the straight-line distance to the goal, a consistent lower bound of the remaining length
+//! (every edge is at least as long as the difference of its ends' distances to the goal), so
+//! the path is still a shortest one while the search settles mostly vertices towards the goal.
 std::vector<int> dijkstra(const TriMesh& mesh, int source, const RoutingObstacles& obstacles,
-                          const std::function<bool(int)>& is_target) {
+                          const std::function<bool(int)>& is_target, const Vec3* goal = nullptr) {
   if (!valid_vertex(mesh, source)) return {};
   const double inf = std::numeric_limits<double>::infinity();
   // Per-thread distances and parents, reset only where a search wrote: re-routing a node runs
@@ -62,13 +67,15 @@ std::vector<int> dijkstra(const TriMesh& mesh, int source, const RoutingObstacle
     dist[v] = d;
     parent[v] = p;
   };
-  using Entry = std::pair<double, int>;
+  // (key, distance, vertex): the key is the distance, plus the goal bound for A*.
+  using Entry = std::tuple<double, double, int>;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
+  auto bound = [&](VertexHandle w) { return goal ? (mesh.point(w) - *goal).norm() : 0.0; };
   set(source, 0.0, -1);
-  queue.emplace(0.0, source);
+  queue.emplace(bound(VertexHandle(source)), 0.0, source);
   int found = -1;
   while (!queue.empty()) {
-    const auto [d, v] = queue.top();
+    const auto [key, d, v] = queue.top();
     queue.pop();
     if (d > dist[v]) continue;
     if (v != source && is_target(v)) {
@@ -83,7 +90,7 @@ std::vector<int> dijkstra(const TriMesh& mesh, int source, const RoutingObstacle
       const double nd = d + (mesh.point(mesh.to_vertex_handle(heh)) - mesh.point(vh)).norm();
       if (nd < dist[w]) {
         set(w, nd, v);
-        queue.emplace(nd, w);
+        queue.emplace(nd + bound(mesh.to_vertex_handle(heh)), nd, w);
       }
     }
   }
@@ -264,7 +271,9 @@ std::vector<int> shortest_path(const TriMesh& mesh, int source, int target,
                                const RoutingObstacles& obstacles) {
   if (!valid_vertex(mesh, source) || !valid_vertex(mesh, target)) return {};
   if (source == target) return {source};
-  return dijkstra(mesh, source, obstacles, [target](int v) { return v == target; });
+  const Vec3 goal = mesh.point(VertexHandle(target));
+  return dijkstra(
+      mesh, source, obstacles, [target](int v) { return v == target; }, &goal);
 }
 
 std::vector<int> shortest_path_to_boundary(const TriMesh& mesh, int source,

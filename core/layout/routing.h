@@ -23,10 +23,10 @@ struct RoutingObstacles {
 //! Marks every vertex and edge used by the existing arc paths and every node vertex.
 RoutingObstacles obstacles_of_layout(const TriMesh& mesh, const Layout& layout);
 
-//! Shortest edge path (Euclidean edge lengths, Dijkstra) from \p source to \p target, not
-//! using blocked edges, and not passing through blocked vertices (source and target may be
-//! blocked). Returns the vertex path (source first): {source} when source == target, empty if
-//! no path exists or a vertex index is out of range.
+//! Shortest edge path (Euclidean edge lengths; A* with the straight-line bound) from \p source to
+//! \p target, not using blocked edges, and not passing through blocked vertices (source and target
+//! may be blocked). Returns the vertex path (source first): {source} when source == target, empty
+//! if no path exists or a vertex index is out of range.
 std::vector<int> shortest_path(const TriMesh& mesh, int source, int target,
                                const RoutingObstacles& obstacles);
 
