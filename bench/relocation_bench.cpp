@@ -5,8 +5,7 @@
 // continuous run first reaches the discrete run's final E. Not a test.
 //
 //   qs_relocation_bench [--rings K] [--seeds N] [--max-steps S] [--case NAME] [--hop-all]
-//   [--gradient exact]
-//                       [--no-discrete] [--verbose] [--hop-OPTION VALUE ...]
+//                       [--no-discrete] [--verbose] [--gradient exact] [--hop-OPTION VALUE ...]
 //
 // --hop-all: the continuous run's hop polish tries every neighbour of every relocated node (no
 // offset, direction or work limit), an experiment against the defaults.
