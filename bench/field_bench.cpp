@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "bench/bench_util.h"
+#include "core/base/allocator.h"
 #include "core/base/spd_solver.h"
 #include "core/field/cross_field.h"
 #include "core/field/curvature.h"
@@ -82,6 +83,7 @@ void row(const char* name, double s, double unit) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  qs::keep_freed_memory();  // as quadsketch-cli and the GUI (core/base/allocator.h)
   std::string mesh_path, layout_path, moved_path;
   int repeat = 5;
   for (int i = 1; i < argc; ++i) {

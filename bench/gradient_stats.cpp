@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "core/base/allocator.h"
 #include "core/layout/layout_io.h"
 #include "core/layout/perturb.h"
 #include "core/mesh/mesh_io.h"
@@ -76,6 +77,7 @@ Stats compare(const std::string& name, const qs::TriMesh& mesh, const qs::Layout
 }  // namespace
 
 int main(int argc, char** argv) {
+  qs::keep_freed_memory();  // as quadsketch-cli and the GUI (core/base/allocator.h)
   std::string json_path;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--json") == 0 && i + 1 < argc) {

@@ -3,6 +3,7 @@
 //
 //   qs_nodeopt_bench MESH LAYOUT [STEPS=10] [REPEATS=3] [descent] [fresh] [parallel] [steps]
 //
+// default-malloc: glibc's allocator defaults instead of the applications' keep_freed_memory().
 // descent: no hop polish and no fold-over removal after the descent (only the STEPS descent
 // steps are timed in "optimize"); fresh: NodeOptOptions::reuse_field off (a fresh Pipeline per
 // trial with re-routed arcs, the behaviour before session 3); parallel:
@@ -28,6 +29,7 @@
 #include <vector>
 
 #include "bench/bench_util.h"
+#include "core/base/allocator.h"
 #include "core/base/solver_threads.h"
 #include "core/layout/layout_io.h"
 #include "core/mesh/mesh_io.h"
@@ -64,7 +66,8 @@ int main(int argc, char** argv) {
   if (argc < 3) {
     std::fprintf(
         stderr,
-        "usage: %s MESH LAYOUT [STEPS=10] [REPEATS=3] [descent] [fresh] [parallel] [steps]\n",
+        "usage: %s MESH LAYOUT [STEPS=10] [REPEATS=3] [descent] [fresh] [parallel] [steps] "
+        "[default-malloc]\n",
         argv[0]);
     return 2;
   }
@@ -82,12 +85,17 @@ int main(int argc, char** argv) {
     // (NodeOptOptions::reuse_field off: a fresh Pipeline per trial with re-routed arcs).
     // "steps": print every step.
     bool descent_only = false, fresh_trials = false, verbose = false, parallel = false;
+    bool keep_memory = true;
     for (int k = 5; k < argc; ++k) {
+      keep_memory &= std::string(argv[k]) != "default-malloc";
       descent_only |= std::string(argv[k]) == "descent";
       fresh_trials |= std::string(argv[k]) == "fresh";
       parallel |= std::string(argv[k]) == "parallel";
       verbose |= std::string(argv[k]) == "steps";
     }
+    // As quadsketch-cli and the GUI do (core/base/allocator.h); "default-malloc": glibc's
+    // defaults (every solve page-faults its factorization in again).
+    if (keep_memory) qs::keep_freed_memory();
     const qs::PipelineOptions options;
     std::vector<double> fresh, resolve, step, total, ratio;
     for (int rep = 0; rep < repeats; ++rep) {

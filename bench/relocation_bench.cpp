@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "bench/bench_util.h"
+#include "core/base/allocator.h"
 #include "core/base/solver_threads.h"
 #include "core/layout/layout_io.h"
 #include "core/layout/perturb.h"
@@ -129,6 +130,7 @@ void print_nodes(const qs::TriMesh& original, const qs::NodeOptResult& r) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  qs::keep_freed_memory();  // as quadsketch-cli and the GUI (core/base/allocator.h)
   int rings = -1, seeds = 2, max_steps = 25;
   bool hop_all = false;      // the hop polish tries every neighbour of every node
   bool no_discrete = false;  // skip the descent-only and discrete runs
