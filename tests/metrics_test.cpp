@@ -5,7 +5,9 @@
 
 #include <cmath>
 
+#include "core/field/cross_field.h"
 #include "core/field/curvature.h"
+#include "core/pipeline/pipeline.h"
 #include "fixtures.h"
 
 namespace qs {
@@ -60,6 +62,52 @@ TEST(Metrics, NonFiniteCornerValuesAreDegenerate) {
   const ParamMetrics m = compute_metrics(in.mesh, g, curv, uv, 0.0);
   EXPECT_EQ(m.degenerate, 1);
   EXPECT_NEAR(m.E_confor, 2.0, 1e-9);
+}
+
+// Pipeline::metrics takes E°'s curvature from the field solver when the field computed it at the
+// same positions: the metrics are bit-identical to a fresh compute_curvature's, and after the
+// vertices moved (the field's solve keeps its constraints and curvature) the fresh one is used.
+TEST(Metrics, PipelineReusesTheFieldsCurvatureOnlyAtTheSamePositions) {
+  auto e = test::cube_sphere(12, Vec3(1.3, 1, 0.75));
+  Pipeline p(e.mesh, e.layout, PipelineOptions{});
+  p.compute_parameterization();
+  ASSERT_NE(p.field_solver(), nullptr);
+  ASSERT_NE(p.field_solver()->curvature_at(p.mesh(), CurvatureOptions{}), nullptr)
+      << "the field computed the curvature E° needs";
+  auto expect_fresh = [](Pipeline& q) {
+    const Parameterization& par = *q.parameterization();
+    const ParamMetrics fresh =
+        compute_metrics(q.mesh(), q.geometry(), compute_curvature(q.mesh(), q.geometry()),
+                        par.corner_uv, par.energy);
+    const ParamMetrics m = q.metrics();
+    EXPECT_EQ(m.E_angle_deg, fresh.E_angle_deg);
+    EXPECT_EQ(m.E_planar, fresh.E_planar);
+    EXPECT_EQ(m.E_confor, fresh.E_confor);
+    EXPECT_GT(m.E_angle_deg, 0.0);
+  };
+  expect_fresh(p);
+  // Other options, or curvature constraints off: no reuse.
+  CurvatureOptions other;
+  other.rings = 3;
+  EXPECT_EQ(p.field_solver()->curvature_at(p.mesh(), other), nullptr);
+  PipelineOptions no_align;
+  no_align.field.constraints.curvature = false;
+  Pipeline q(e.mesh, e.layout, no_align);
+  q.compute_parameterization();
+  ASSERT_NE(q.field_solver(), nullptr);
+  EXPECT_EQ(q.field_solver()->curvature_at(q.mesh(), CurvatureOptions{}), nullptr);
+  expect_fresh(q);
+  // Moved vertices: the field's curvature is of the old positions.
+  TriMesh moved = p.mesh();
+  for (int v = 0; v < 40; ++v) {
+    const auto vh = moved.vertex_handle(v);
+    moved.set_point(vh, moved.point(vh) * 1.02);
+  }
+  p.update_positions(moved);
+  p.compute_parameterization();
+  ASSERT_NE(p.field_solver(), nullptr);
+  EXPECT_EQ(p.field_solver()->curvature_at(p.mesh(), CurvatureOptions{}), nullptr);
+  expect_fresh(p);
 }
 
 }  // namespace

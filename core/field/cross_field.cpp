@@ -32,6 +32,18 @@ CrossFieldSolver::CrossFieldSolver(const TriMesh& mesh, const GeometryCache& g,
   field_.timings.setup_s = seconds_since(t_setup);
 }
 
+const Curvature* CrossFieldSolver::curvature_at(const TriMesh& mesh,
+                                                const CurvatureOptions& options) const {
+  const CurvatureCache& c = curvature_cache_;
+  if (!options_.constraints.curvature || c.options != options ||
+      c.points.size() != mesh.n_vertices() ||
+      c.curvature.k_max.size() != static_cast<size_t>(mesh.n_faces()))
+    return nullptr;
+  for (auto v : mesh.vertices())
+    if (c.points[v.idx()] != mesh.point(v)) return nullptr;
+  return &c.curvature;
+}
+
 FieldConstraints CrossFieldSolver::current_constraints(const TriMesh& mesh, const GeometryCache& g,
                                                        const Layout& layout) {
   Curvature curvature;

@@ -129,6 +129,11 @@ class CrossFieldSolver {
   //! Rotates the whole field by φ (radians) — meaningful only when it has no direction
   //! constraints (its global rotation is then free); later re-solves keep the rotation.
   void rotate(double phi);
+  //! The curvature this solver computed for its constraints when it was computed from
+  //! \p options at exactly \p mesh's vertex positions (same vertex count), else nullptr (curvature
+  //! constraints off, other options, or positions moved since: solve() keeps the constraints).
+  //! Bit-identical to compute_curvature(mesh, geometry, options) (update_curvature).
+  const Curvature* curvature_at(const TriMesh& mesh, const CurvatureOptions& options) const;
   //! The field matrix currently factorized (dual-graph Laplacian + λ on active constraints).
   const Eigen::SparseMatrix<double>& matrix() const { return matrix_; }
 

@@ -134,11 +134,6 @@ void classify_reliable(const TriMesh& mesh, const CurvatureOptions& opt,
   c.reliable_faces = static_cast<int>(std::count(c.reliable.begin(), c.reliable.end(), 1));
 }
 
-bool same_options(const CurvatureOptions& a, const CurvatureOptions& b) {
-  return a.rings == b.rings && a.min_anisotropy == b.min_anisotropy && a.min_ratio == b.min_ratio &&
-         a.min_region_faces == b.min_region_faces;
-}
-
 }  // namespace
 
 Curvature compute_curvature(const TriMesh& mesh, const GeometryCache& g,
@@ -192,7 +187,7 @@ Curvature update_curvature(const TriMesh& mesh, const GeometryCache& g, const Cu
   const int levels = std::max(1, opt.rings);
   if (static_cast<int>(cache.points.size()) != nv ||
       static_cast<int>(cache.magnitude.size()) != nf ||
-      static_cast<int>(cache.tensor.size()) != levels || !same_options(cache.options, opt))
+      static_cast<int>(cache.tensor.size()) != levels || cache.options != opt)
     return compute_curvature(mesh, g, opt, &cache);
   // Vertices whose tensor or area can change: the vertices of the faces around moved ones.
   std::vector<char> moved(nv, 0), in_set(nv, 0);

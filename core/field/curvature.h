@@ -22,6 +22,7 @@ struct CurvatureOptions {
   double min_ratio = 0.5;
   //! Reliable regions with fewer faces than this are dropped as noise.
   int min_region_faces = 8;
+  bool operator==(const CurvatureOptions&) const = default;
 };
 
 //! Per-face principal curvatures (1/length units) and directions (unit, in the face plane).

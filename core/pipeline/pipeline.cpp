@@ -117,7 +117,12 @@ const Extraction& Pipeline::extract() {
 
 ParamMetrics Pipeline::metrics() {
   if (!param_solver_) compute_parameterization();
-  if (!curvature_) curvature_ = std::make_unique<Curvature>(compute_curvature(mesh_, geometry_));
+  if (!curvature_) {  // the field's own curvature when it is the one E° needs (same positions)
+    const Curvature* field_curvature =
+        field_solver_ ? field_solver_->curvature_at(mesh_, CurvatureOptions{}) : nullptr;
+    curvature_ = std::make_unique<Curvature>(field_curvature ? *field_curvature
+                                                             : compute_curvature(mesh_, geometry_));
+  }
   const auto& r = param_solver_->result();
   return compute_metrics(mesh_, geometry_, *curvature_, r.corner_uv, r.energy);
 }

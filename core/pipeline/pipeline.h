@@ -73,6 +73,10 @@ class Pipeline {
   //! Computes (or re-solves) the cross field. \throw TopologyError, SolverError.
   const CrossField& compute_field();
   const CrossField* field() const;
+  //! The field's solver when the field is current (compute_field), else nullptr.
+  const CrossFieldSolver* field_solver() const {
+    return field_current() ? field_solver_.get() : nullptr;
+  }
   //! Singular vertices measured on the current field (interior vertices only).
   std::vector<Singularity> singularities() const;
 
