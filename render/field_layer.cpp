@@ -166,7 +166,10 @@ void FieldLayer::upload(const SceneData& data) {
       const int f = field.constraint_faces[k];
       const glm::vec3 d = in_plane(f, field.constraint_direction[k], c_arm);
       if (d == glm::vec3(0.0f)) continue;
-      const glm::vec3 color = FieldColors::constraint(field.constraint_kind[k]);
+      const bool in_force =
+          std::size_t(k) >= field.constraint_in_force.size() || field.constraint_in_force[k];
+      const glm::vec3 color =
+          in_force ? FieldColors::constraint(field.constraint_kind[k]) : FieldColors::kReleased;
       push_glyph(glyphs, centroid[f], d, normal[f], glm::vec4(color, 0.95f), glm::vec4(0.0f),
                  width * 2.4f);
       ++constraints_;
@@ -235,14 +238,18 @@ void FieldLayer::ui() {
   const struct {
     int kind;
     const char* name;
-  } kinds[] = {{0, "curvature"}, {1, "feature"}, {2, "boundary"}};
+  } kinds[] = {{0, "curvature"}, {1, "feature"}, {2, "boundary"}, {-1, "released"}};
   for (const auto& k : kinds) {
-    const glm::vec3 c = FieldColors::constraint(k.kind);
+    const glm::vec3 c = k.kind < 0 ? FieldColors::kReleased : FieldColors::constraint(k.kind);
     ImGui::ColorButton(k.name, ImVec4(c.r, c.g, c.b, 1.0f),
                        ImGuiColorEditFlags_NoTooltip | ImGuiColorEditFlags_NoPicker,
                        ImVec2(ImGui::GetFontSize(), ImGui::GetFontSize()));
     ImGui::SameLine();
     ImGui::TextUnformatted(k.name);
+    if (k.kind < 0 && ImGui::IsItemHovered())
+      ImGui::SetTooltip(
+          "Constraints released because their cluster contradicts the layout's\n"
+          "topology: the field ignores them.");
     ImGui::SameLine();
   }
   ImGui::NewLine();

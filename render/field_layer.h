@@ -1,6 +1,7 @@
 // The cross field as glyphs: a short cross per face (subsampled on a uniform grid for large
 // meshes) from the job's latest field, and the faces whose direction is constrained (reliable
-// curvature directions, features, boundary) as single bars coloured by kind.
+// curvature directions, features, boundary) as single bars coloured by kind, grey where the
+// constraint was released as contradicting the layout.
 #pragma once
 
 #include <cstdint>
@@ -17,6 +18,8 @@ struct FieldColors {
   static constexpr glm::vec3 kCurvature{0.95f, 0.55f, 0.05f};
   static constexpr glm::vec3 kFeature{0.05f, 0.75f, 0.85f};
   static constexpr glm::vec3 kBoundary{0.85f, 0.15f, 0.65f};
+  //! A constraint released because its cluster contradicts the layout (the field ignores it).
+  static constexpr glm::vec3 kReleased{0.55f, 0.55f, 0.55f};
   //! Colour of a ConstraintKind value (0 curvature, 1 feature, 2 boundary).
   static glm::vec3 constraint(int kind);
 };

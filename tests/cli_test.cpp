@@ -145,6 +145,48 @@ TEST(Cli, FieldWritesSingularitiesAndDirections) {
   EXPECT_EQ(lines, static_cast<int>(mesh.n_faces()));
 }
 
+TEST(Cli, FieldAndOptimizeReportReleasedConstraintsAndWarn) {
+  // The curvature clusters of this ellipsoid contradict the cube layout and are released
+  // (tests/field_test.cpp): both commands say so in report.json and on stderr, even --quiet.
+  const auto in = test::cube_sphere(10, Vec3(2.0, 1.0, 0.75));
+  const std::string dir = test::temp_dir("cli_released");
+  test::write_obj(in.mesh, dir + "/mesh.obj");
+  save_layout(in.layout, dir + "/layout.json", &in.mesh);
+  const std::string files = " --mesh " + dir + "/mesh.obj --layout " + dir + "/layout.json";
+  auto check = [](const nlohmann::json& c, const std::string& output) {
+    const int constrained =
+        c["curvature"].get<int>() + c["feature"].get<int>() + c["boundary"].get<int>();
+    const auto& f = c["in_force"];
+    EXPECT_GT(constrained, 0);
+    EXPECT_EQ(f["total"].get<int>(),
+              f["curvature"].get<int>() + f["feature"].get<int>() + f["boundary"].get<int>());
+    EXPECT_LE(f["curvature"].get<int>(), c["curvature"].get<int>());
+    EXPECT_LT(f["total"].get<int>(), constrained / 2);
+    EXPECT_GT(c["dropped_clusters"].get<int>(), 0);
+    EXPECT_LE(c["dropped_clusters"].get<int>(), c["clusters"].get<int>());
+    EXPECT_NE(output.find("warning:"), std::string::npos) << output;
+    EXPECT_NE(output.find("released"), std::string::npos) << output;
+  };
+  std::string out;
+  ASSERT_EQ(test::run_command(cli("field" + files + " --out " + dir + "/field"), &out), 0) << out;
+  check(read_json(dir + "/field/report.json")["constraints"], out);
+  ASSERT_EQ(test::run_command(
+                cli("optimize --quiet --no-node-opt" + files + " --out " + dir + "/opt"), &out),
+            0)
+      << out;
+  const auto report = read_json(dir + "/opt/report.json");
+  check(report["field"]["constraints"], out);
+  EXPECT_EQ(report["field"]["singularities"].get<int>(), 8);
+  // No constraints, no such warning: the bundled example with --no-align.
+  ASSERT_EQ(test::run_command(cli("optimize --quiet --no-node-opt --no-align --mesh " + kMesh +
+                                  " --layout " + kLayout + " --out " + dir + "/plain"),
+                              &out),
+            0)
+      << out;
+  EXPECT_EQ(out.find("released"), std::string::npos) << out;
+  EXPECT_EQ(read_json(dir + "/plain/report.json")["field"]["constraints"]["in_force"]["total"], 0);
+}
+
 TEST(Cli, OptimizeWithoutNodeOptimizationWritesEverything) {
   const std::string dir = test::temp_dir("cli_optimize");
   std::string out;

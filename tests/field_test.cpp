@@ -352,6 +352,53 @@ TEST(CrossField, RelaxedWarmStartRoundsLikeTheLargestClusterWarmStart) {
   EXPECT_GE(multi, 2) << "the cases must exercise several clusters";
 }
 
+TEST(CrossField, ConstraintSummaryCountsWhatIsInForceAndWarnsWhenMostIsReleased) {
+  // On this ellipsoid the curvature clusters contradict the cube layout (see below): the
+  // default drop passes release whole clusters, the face-local mode only faces near the
+  // steep edges.
+  const auto in = test::cube_sphere(10, Vec3(2.0, 1.0, 0.75));
+  CrossFieldOptions faces;
+  faces.conflict_drop = ConflictDrop::Faces;
+  for (const CrossFieldOptions& opt : {CrossFieldOptions{}, faces}) {
+    const Solved s = solve_field(in, 0, opt);
+    const ConstraintSummary sum = summarize_constraints(s.field);
+    ASSERT_EQ(sum.total_constrained(), static_cast<int>(s.field.constraints.face.size()));
+    EXPECT_EQ(sum.constrained[0], s.field.constraints.count(ConstraintKind::Curvature));
+    EXPECT_EQ(sum.constrained[1], s.field.constraints.count(ConstraintKind::Feature));
+    EXPECT_EQ(sum.constrained[2], s.field.constraints.count(ConstraintKind::Boundary));
+    EXPECT_EQ(sum.total_in_force(), s.field.active_constraints);
+    for (int k = 0; k < 3; ++k) EXPECT_LE(sum.in_force[k], sum.constrained[k]);
+    EXPECT_EQ(sum.clusters, s.field.clusters);
+    EXPECT_EQ(sum.dropped_clusters, s.field.dropped_clusters);
+    ASSERT_GT(sum.total_constrained(), 0);
+    ASSERT_LT(sum.total_in_force(), sum.total_constrained()) << "the case must release some";
+    // The warning appears exactly when less than the given fraction is in force, and names
+    // the counts.
+    const double fraction = double(sum.total_in_force()) / sum.total_constrained();
+    const std::string below = released_constraints_warning(s.field, fraction + 1e-9);
+    ASSERT_FALSE(below.empty());
+    EXPECT_NE(below.find(std::to_string(sum.total_in_force()) + " of " +
+                         std::to_string(sum.total_constrained()) + " constrained faces"),
+              std::string::npos)
+        << below;
+    EXPECT_NE(below.find(std::to_string(sum.dropped_clusters) + " of " +
+                         std::to_string(sum.clusters) + " constraint clusters"),
+              std::string::npos)
+        << below;
+    EXPECT_TRUE(released_constraints_warning(s.field, fraction).empty());
+    std::printf("[stat] %s drop: %d of %d constrained faces in force, %d of %d clusters released\n",
+                opt.conflict_drop == ConflictDrop::Faces ? "face-local" : "cluster",
+                sum.total_in_force(), sum.total_constrained(), sum.dropped_clusters, sum.clusters);
+  }
+  // Without constraints there is nothing to warn about.
+  CrossFieldOptions oblivious;
+  oblivious.constraints.curvature = false;
+  const Solved plain = solve_field(in, 0, oblivious);
+  ASSERT_TRUE(plain.field.constraints.face.empty());
+  EXPECT_EQ(summarize_constraints(plain.field).total_constrained(), 0);
+  EXPECT_TRUE(released_constraints_warning(plain.field, 1.0).empty());
+}
+
 TEST(CrossField, FaceLocalConflictDropReleasesFewerConstraints) {
   // On this ellipsoid both curvature clusters contradict the cube layout near its corners.
   // Whole-cluster dropping releases every constraint; the experimental face-local mode only

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "app/gui/pipeline_job.h"
+#include "tests/fixtures.h"
 #include "tests/gui_job_fixture.h"
 #ifdef QS_TEST_RENDER
 #include "render/field_layer.h"
@@ -62,6 +63,31 @@ TEST(GuiField, SnapshotCarriesUnitInPlaneDirectionsAndConstraints) {
     const auto& d = field.constraint_direction[k];
     EXPECT_NEAR(std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), 1.0, 1e-5);
   }
+}
+
+TEST(GuiField, SnapshotMarksReleasedConstraintsAndWarns) {
+  // The curvature clusters of this ellipsoid contradict the cube layout and are released
+  // (tests/field_test.cpp): the editor shows them as released and warns in the Metrics panel.
+  const auto in = test::cube_sphere(10, Vec3(2.0, 1.0, 0.75));
+  const Example ex{std::make_shared<TriMesh>(in.mesh), in.layout};
+  const auto s = solve_once(ex, WorkerOptions{});
+  ASSERT_EQ(s->status, WorkerStatus::Finished) << s->message;
+  ASSERT_TRUE(s->field);
+  const FieldView& field = *s->field;
+  ASSERT_GT(field.constraint_faces.size(), 0u);
+  ASSERT_EQ(field.constraint_in_force.size(), field.constraint_faces.size());
+  int in_force = 0;
+  for (char c : field.constraint_in_force) in_force += c != 0;
+  EXPECT_LT(in_force, static_cast<int>(field.constraint_faces.size()));
+  EXPECT_GT(field.dropped_clusters, 0);
+  EXPECT_LE(field.dropped_clusters, field.clusters);
+  EXPECT_NE(field.warning.find("released"), std::string::npos) << field.warning;
+  // Without constraints (the bundled example at the default thresholds) there is no warning.
+  const auto e = solve_once(example(), WorkerOptions{});
+  ASSERT_TRUE(e->field);
+  EXPECT_TRUE(e->field->constraint_faces.empty());
+  EXPECT_TRUE(e->field->constraint_in_force.empty());
+  EXPECT_TRUE(e->field->warning.empty()) << e->field->warning;
 }
 
 TEST(GuiField, PanelOptionsReachTheJob) {

@@ -222,6 +222,9 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
                          {"E_angle_deg", m.E_angle_deg},
                          {"foldovers", m.foldovers},
                          {"degenerate_faces", m.degenerate}};
+    report["field"] = {{"constraints", constraints_json(field)},
+                       {"singularities", pipeline.singularities().size()}};
+    warn_about_released_constraints(field, "optimize");
     report["structurally_equivalent"] = ex.structurally_equivalent;
     report["extraction_problems"] = ex.problems;
     report["bad_cones"] = ex.bad_cones;

@@ -15,7 +15,6 @@
 
 namespace qs::cli {
 
-
 int run_validate(const ValidateOptions& o, const CommonOptions& common) {
   MeshReport report;
   const TriMesh mesh = load_mesh(o.mesh, &report);
@@ -86,10 +85,8 @@ int run_field(const FieldOptions& o, const CommonOptions& common) {
     for (const auto& s : pipeline.singularities())
       singularities.push_back({{"vertex", s.vertex}, {"index", s.quarter_index / 4.0}});
     report["singularities"] = singularities;
-    report["constraints"] = {{"curvature", field.constraints.count(ConstraintKind::Curvature)},
-                             {"feature", field.constraints.count(ConstraintKind::Feature)},
-                             {"boundary", field.constraints.count(ConstraintKind::Boundary)},
-                             {"clusters", field.clusters}};
+    report["constraints"] = constraints_json(field);
+    warn_about_released_constraints(field, "field");
     report["period_jumps"] = {{"free_unknowns", field.topology.free_unknowns},
                               {"layout_cycles", field.topology.cycles},
                               {"max_abs", field.topology.max_abs_jump}};
@@ -105,8 +102,9 @@ int run_field(const FieldOptions& o, const CommonOptions& common) {
                            {"total", seconds_since(t_total)}};
     if (!common.quiet) {
       std::cerr << "field: " << pipeline.singularities().size() << " singular vertices, "
-                << field.constraints.face.size() << " constrained faces, " << field_s
-                << " s; wrote " << o.out << "/field.txt and report.json\n";
+                << field.constraints.face.size() << " constrained faces ("
+                << field.active_constraints << " in force), " << field_s << " s; wrote " << o.out
+                << "/field.txt and report.json\n";
     }
   });
 }

@@ -12,6 +12,7 @@
 #include "core/base/atomic_file.h"
 #include "core/base/errors.h"
 #include "core/base/timing.h"
+#include "core/field/cross_field.h"
 #include "core/layout/layout.h"
 #include "core/mesh/mesh_io.h"
 
@@ -40,6 +41,28 @@ inline nlohmann::json layout_json(const LayoutTopology& topo) {
           {"arcs", topo.num_arcs},
           {"patches", topo.patches.size()},
           {"irregular_nodes", irregular}};
+}
+
+//! The field's direction constraints: faces per kind, clusters, and what is still in force
+//! after the clusters that contradict the layout were released.
+inline nlohmann::json constraints_json(const CrossField& field) {
+  const ConstraintSummary s = summarize_constraints(field);
+  return {{"curvature", s.constrained[0]},
+          {"feature", s.constrained[1]},
+          {"boundary", s.constrained[2]},
+          {"clusters", s.clusters},
+          {"dropped_clusters", s.dropped_clusters},
+          {"in_force",
+           {{"curvature", s.in_force[0]},
+            {"feature", s.in_force[1]},
+            {"boundary", s.in_force[2]},
+            {"total", s.total_in_force()}}}};
+}
+
+//! Prints released_constraints_warning (when there is one) to stderr, prefixed by \p command.
+inline void warn_about_released_constraints(const CrossField& field, const std::string& command) {
+  const std::string w = released_constraints_warning(field);
+  if (!w.empty()) std::cerr << "warning: " << command << ": " << w << "\n";
 }
 
 //! Runs a command that writes into an output folder: report.json is written also on failure,

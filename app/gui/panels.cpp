@@ -581,6 +581,24 @@ void App::draw_metrics_panel() {
       ImGui::TextColored(m.foldovers > 0 ? kErrorColor : kOkColor, "%d", m.foldovers);
     else
       ImGui::TextDisabled("-");
+    // Direction constraints in force: few when the layout contradicts the curvature/features.
+    if (s.field && !s.field->constraint_faces.empty()) {
+      const FieldView& f = *s.field;
+      int in_force = 0;
+      for (char c : f.constraint_in_force) in_force += c != 0;
+      ImGui::TableNextRow();
+      ImGui::TableNextColumn();
+      ImGui::TextUnformatted("aligned faces");
+      if (ImGui::IsItemHovered())
+        ImGui::SetTooltip(
+            "Faces whose direction constraint (curvature, feature, boundary) is in force.\n"
+            "Constraint clusters that contradict the layout's topology are released\n"
+            "(grey bars in the cross-field view): there the field follows the layout.");
+      ImGui::TableNextColumn();
+      ImGui::TextColored(f.warning.empty() ? kOkColor : kWarningColor, "%d / %d", in_force,
+                         int(f.constraint_faces.size()));
+      if (!f.warning.empty() && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", f.warning.c_str());
+    }
     ImGui::EndTable();
   }
   ImGui::TextDisabled("Timings, step %d (ms)", s.iteration);

@@ -74,7 +74,8 @@ PipelineOptions pipeline_options(const WorkerOptions& o) {
   return options;
 }
 
-// The solved field for display: first direction per face and the constraints in force.
+// The solved field for display: first direction per face and the constraints (in force or
+// released).
 std::shared_ptr<const FieldView> field_view(const Pipeline& pipeline) {
   const CrossField* field = pipeline.field();
   if (!field) return nullptr;
@@ -88,7 +89,12 @@ std::shared_ptr<const FieldView> field_view(const Pipeline& pipeline) {
     view->constraint_direction.push_back(
         {float(c.direction[k][0]), float(c.direction[k][1]), float(c.direction[k][2])});
     view->constraint_kind.push_back(static_cast<char>(c.kind[k]));
+    view->constraint_in_force.push_back(
+        k < field->constraint_active.size() ? field->constraint_active[k] : char(1));
   }
+  view->clusters = field->clusters;
+  view->dropped_clusters = field->dropped_clusters;
+  view->warning = released_constraints_warning(*field);
   return view;
 }
 

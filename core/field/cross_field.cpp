@@ -5,6 +5,7 @@
 #include <chrono>
 #include <climits>
 #include <cmath>
+#include <cstdio>
 
 #include "core/base/errors.h"
 #include "core/base/timing.h"
@@ -763,6 +764,35 @@ CrossField compute_cross_field(const TriMesh& mesh, const GeometryCache& geometr
                                const CrossFieldOptions& options) {
   CrossFieldSolver solver(mesh, geometry, layout, topology, options);
   return solver.field();
+}
+
+ConstraintSummary summarize_constraints(const CrossField& field) {
+  ConstraintSummary s;
+  const FieldConstraints& c = field.constraints;
+  for (size_t k = 0; k < c.face.size() && k < c.kind.size(); ++k) {
+    const int kind = static_cast<int>(c.kind[k]);
+    if (kind < 0 || kind > 2) continue;
+    ++s.constrained[kind];
+    // Before the first solve constraint_active is empty: every constraint is in force then.
+    if (k >= field.constraint_active.size() || field.constraint_active[k]) ++s.in_force[kind];
+  }
+  s.clusters = field.clusters;
+  s.dropped_clusters = field.dropped_clusters;
+  return s;
+}
+
+std::string released_constraints_warning(const CrossField& field, double min_in_force) {
+  const ConstraintSummary s = summarize_constraints(field);
+  const int total = s.total_constrained(), in_force = s.total_in_force();
+  if (total == 0 || in_force >= min_in_force * total) return {};
+  char percent[32];
+  std::snprintf(percent, sizeof percent, "%.1f", 100.0 * in_force / total);
+  return std::to_string(s.dropped_clusters) + " of " + std::to_string(s.clusters) +
+         " constraint clusters contradict the layout's topology and were released: " +
+         std::to_string(in_force) + " of " + std::to_string(total) + " constrained faces (" +
+         percent +
+         " %) are in force, so the field follows the layout rather than the curvature and "
+         "features there (a layout whose arcs follow them keeps more)";
 }
 
 std::vector<int> principal_matching(const GeometryCache& g, const std::vector<double>& theta) {

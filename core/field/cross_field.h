@@ -4,7 +4,9 @@
 // cluster. The matrix depends on neither geometry nor q: it is factorized once.
 #pragma once
 
+#include <array>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "core/base/spd_solver.h"
@@ -206,6 +208,26 @@ class CrossFieldSolver {
   SpdSolver full_{"cross field"};
   int full_gauge_face_ = -1;
 };
+
+//! What became of a field's direction constraints: how many faces each kind constrained and how
+//! many of them are still in force after the constraint clusters that contradict the layout's
+//! topology were released (CrossField::constraint_active). For reports and the editor.
+struct ConstraintSummary {
+  std::array<int, 3> constrained{};  //!< per ConstraintKind (curvature, feature, boundary)
+  std::array<int, 3> in_force{};     //!< per ConstraintKind, of `constrained`
+  int clusters = 0;
+  int dropped_clusters = 0;  //!< clusters with no constraint in force
+  int total_constrained() const { return constrained[0] + constrained[1] + constrained[2]; }
+  int total_in_force() const { return in_force[0] + in_force[1] + in_force[2]; }
+};
+
+ConstraintSummary summarize_constraints(const CrossField& field);
+
+//! A one-line warning when fewer than \p min_in_force (a fraction) of the constrained faces are
+//! in force, e.g. "11 of 12 constraint clusters contradict the layout's topology and were
+//! released: 27 of 11114 constrained faces (0.2 %) are in force, so the field follows the
+//! layout rather than the curvature there". Empty otherwise (also without constraints).
+std::string released_constraints_warning(const CrossField& field, double min_in_force = 0.5);
 
 //! Convenience: geometry + topology + one solve.
 CrossField compute_cross_field(const TriMesh& mesh, const GeometryCache& geometry,

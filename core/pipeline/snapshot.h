@@ -61,12 +61,19 @@ struct FieldView {
   //! Per face (size #F): the field's first direction (unit, in the face plane of the job's
   //! surface); the second is its 90° rotation about the face normal.
   std::vector<std::array<float, 3>> direction;
-  //! Faces with a direction constraint in force (reliable curvature, feature or boundary),
-  //! parallel arrays: face index, constrained direction (unit), kind (ConstraintKind value:
-  //! 0 curvature, 1 feature, 2 boundary).
+  //! Faces with a direction constraint (reliable curvature, feature or boundary), parallel
+  //! arrays: face index, constrained direction (unit), kind (ConstraintKind value: 0 curvature,
+  //! 1 feature, 2 boundary), whether it is in force.
   std::vector<int> constraint_faces;
   std::vector<std::array<float, 3>> constraint_direction;
   std::vector<char> constraint_kind;
+  //! Parallel to constraint_faces: 1 when the constraint is in force, 0 when its cluster was
+  //! released as contradicting the layout's topology (the field ignores it).
+  std::vector<char> constraint_in_force;
+  int clusters = 0;          //!< constraint clusters
+  int dropped_clusters = 0;  //!< clusters released (none of their constraints in force)
+  //! released_constraints_warning of the field (empty when most constraints are in force).
+  std::string warning;
 };
 
 //! Immutable job data the exporters need (defined by the job that fills it, e.g. the editor's
