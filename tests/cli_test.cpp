@@ -177,6 +177,16 @@ TEST(Cli, FieldAndOptimizeReportReleasedConstraintsAndWarn) {
   const auto report = read_json(dir + "/opt/report.json");
   check(report["field"]["constraints"], out);
   EXPECT_EQ(report["field"]["singularities"].get<int>(), 8);
+  // With node optimization the warning comes once, before the run, about the initial field.
+  ASSERT_EQ(test::run_command(
+                cli("optimize --quiet --steps 2" + files + " --out " + dir + "/steps"), &out),
+            0)
+      << out;
+  check(read_json(dir + "/steps/report.json")["field"]["constraints"], out);
+  const size_t first = out.find("released");
+  ASSERT_NE(first, std::string::npos) << out;
+  EXPECT_EQ(out.find("released", first + 1), std::string::npos) << out;
+  EXPECT_NE(out.find("optimize (initial field)"), std::string::npos) << out;
   // No constraints, no such warning: the bundled example with --no-align.
   ASSERT_EQ(test::run_command(cli("optimize --quiet --no-node-opt --no-align --mesh " + kMesh +
                                   " --layout " + kLayout + " --out " + dir + "/plain"),

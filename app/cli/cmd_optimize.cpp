@@ -66,6 +66,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     double node_s = 0;
     std::optional<NodeOptResult> node_result;
     ProgressPrinter printer(common.quiet);
+    bool warned_about_constraints = false;
     const auto optimize = [&](const TriMesh& start_mesh, const Layout& start_layout,
                               const PipelineOptions& run_options) {
       if (o.discrete_relocation) {
@@ -82,7 +83,16 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       // Integer sizes put nodes exactly on shared iso-lines: fresh trial Pipelines there (see
       // NodeOptOptions::reuse_field).
       if (o.integer) no.reuse_field = false;
-      return optimize_nodes(start_mesh, start_layout, run_options, no, &printer);
+      // The initial solve here rather than inside the optimizer, so that a layout that
+      // contradicts the curvature is reported before a long run rather than after it.
+      std::shared_ptr<Pipeline> start;
+      if (!warned_about_constraints) {
+        start = std::make_shared<Pipeline>(start_mesh, start_layout, run_options);
+        start->compute_parameterization();
+        warned_about_constraints =
+            warn_about_released_constraints(*start->field(), "optimize (initial field)");
+      }
+      return optimize_nodes(start_mesh, start_layout, run_options, no, &printer, start);
     };
     // After a run: its mesh, layout and the options of its final solve.
     const auto adopt = [&](NodeOptResult result) {
@@ -224,7 +234,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
                          {"degenerate_faces", m.degenerate}};
     report["field"] = {{"constraints", constraints_json(field)},
                        {"singularities", pipeline.singularities().size()}};
-    warn_about_released_constraints(field, "optimize");
+    if (!warned_about_constraints) warn_about_released_constraints(field, "optimize");
     report["structurally_equivalent"] = ex.structurally_equivalent;
     report["extraction_problems"] = ex.problems;
     report["bad_cones"] = ex.bad_cones;

@@ -60,9 +60,11 @@ inline nlohmann::json constraints_json(const CrossField& field) {
 }
 
 //! Prints released_constraints_warning (when there is one) to stderr, prefixed by \p command.
-inline void warn_about_released_constraints(const CrossField& field, const std::string& command) {
+//! \return whether it printed one.
+inline bool warn_about_released_constraints(const CrossField& field, const std::string& command) {
   const std::string w = released_constraints_warning(field);
   if (!w.empty()) std::cerr << "warning: " << command << ": " << w << "\n";
+  return !w.empty();
 }
 
 //! Runs a command that writes into an output folder: report.json is written also on failure,
