@@ -787,12 +787,15 @@ std::string released_constraints_warning(const CrossField& field, double min_in_
   if (total == 0 || in_force >= min_in_force * total) return {};
   char percent[32];
   std::snprintf(percent, sizeof percent, "%.1f", 100.0 * in_force / total);
-  return std::to_string(s.dropped_clusters) + " of " + std::to_string(s.clusters) +
-         " constraint clusters contradict the layout's topology and were released: " +
-         std::to_string(in_force) + " of " + std::to_string(total) + " constrained faces (" +
-         percent +
-         " %) are in force, so the field follows the layout rather than the curvature and "
-         "features there (a layout whose arcs follow them keeps more)";
+  const std::string clusters = s.dropped_clusters > 0
+                                   ? " (" + std::to_string(s.dropped_clusters) + " of " +
+                                         std::to_string(s.clusters) + " constraint clusters)"
+                                   : "";
+  return std::to_string(in_force) + " of " + std::to_string(total) + " constrained faces (" +
+         percent + " %) are in force: the others contradict the layout's topology and were " +
+         "released" + clusters +
+         ", so the field follows the layout rather than the curvature and features there (a "
+         "layout whose arcs follow them keeps more)";
 }
 
 std::vector<int> principal_matching(const GeometryCache& g, const std::vector<double>& theta) {

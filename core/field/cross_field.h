@@ -224,9 +224,10 @@ struct ConstraintSummary {
 ConstraintSummary summarize_constraints(const CrossField& field);
 
 //! A one-line warning when fewer than \p min_in_force (a fraction) of the constrained faces are
-//! in force, e.g. "11 of 12 constraint clusters contradict the layout's topology and were
-//! released: 27 of 11114 constrained faces (0.2 %) are in force, so the field follows the
-//! layout rather than the curvature there". Empty otherwise (also without constraints).
+//! in force, e.g. "27 of 11114 constrained faces (0.2 %) are in force: the others contradict
+//! the layout's topology and were released (11 of 12 constraint clusters), so the field follows
+//! the layout rather than the curvature and features there (…)". Empty otherwise (also without
+//! constraints).
 std::string released_constraints_warning(const CrossField& field, double min_in_force = 0.5);
 
 //! Convenience: geometry + topology + one solve.
