@@ -584,8 +584,6 @@ void App::draw_metrics_panel() {
     // Direction constraints in force: few when the layout contradicts the curvature/features.
     if (s.field && !s.field->constraint_faces.empty()) {
       const FieldView& f = *s.field;
-      int in_force = 0;
-      for (char c : f.constraint_in_force) in_force += c != 0;
       ImGui::TableNextRow();
       ImGui::TableNextColumn();
       ImGui::TextUnformatted("aligned faces");
@@ -595,7 +593,7 @@ void App::draw_metrics_panel() {
             "Constraint clusters that contradict the layout's topology are released\n"
             "(grey bars in the cross-field view): there the field follows the layout.");
       ImGui::TableNextColumn();
-      ImGui::TextColored(f.warning.empty() ? kOkColor : kWarningColor, "%d / %d", in_force,
+      ImGui::TextColored(f.warning.empty() ? kOkColor : kWarningColor, "%d / %d", f.in_force,
                          int(f.constraint_faces.size()));
       if (!f.warning.empty() && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", f.warning.c_str());
     }

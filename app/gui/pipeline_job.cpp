@@ -91,6 +91,7 @@ std::shared_ptr<const FieldView> field_view(const Pipeline& pipeline) {
     view->constraint_kind.push_back(static_cast<char>(c.kind[k]));
     view->constraint_in_force.push_back(
         k < field->constraint_active.size() ? field->constraint_active[k] : char(1));
+    view->in_force += view->constraint_in_force.back() != 0;
   }
   view->clusters = field->clusters;
   view->dropped_clusters = field->dropped_clusters;

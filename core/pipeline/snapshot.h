@@ -70,6 +70,7 @@ struct FieldView {
   //! Parallel to constraint_faces: 1 when the constraint is in force, 0 when its cluster was
   //! released as contradicting the layout's topology (the field ignores it).
   std::vector<char> constraint_in_force;
+  int in_force = 0;          //!< number of 1s in constraint_in_force
   int clusters = 0;          //!< constraint clusters
   int dropped_clusters = 0;  //!< clusters released (none of their constraints in force)
   //! released_constraints_warning of the field (empty when most constraints are in force).
