@@ -197,6 +197,42 @@ TEST(Cli, FieldAndOptimizeReportReleasedConstraintsAndWarn) {
   EXPECT_EQ(read_json(dir + "/plain/report.json")["field"]["constraints"]["in_force"]["total"], 0);
 }
 
+TEST(Cli, MaxClusterFacesKeepsMoreCurvatureConstraintsInForce) {
+  // The same ellipsoid: with --max-cluster-faces 10 the split curvature clusters stay in force
+  // where they fit the layout (CrossFieldOptions::max_cluster_faces), in both commands, and the
+  // layout's 8 singularities stay. A negative size is a usage error (exit code 1).
+  const auto in = test::cube_sphere(10, Vec3(2.0, 1.0, 0.75));
+  const std::string dir = test::temp_dir("cli_split_clusters");
+  test::write_obj(in.mesh, dir + "/mesh.obj");
+  save_layout(in.layout, dir + "/layout.json", &in.mesh);
+  const std::string files = " --mesh " + dir + "/mesh.obj --layout " + dir + "/layout.json";
+  std::string out;
+  ASSERT_EQ(test::run_command(cli("field" + files + " --out " + dir + "/whole"), &out), 0) << out;
+  ASSERT_EQ(test::run_command(
+                cli("field" + files + " --max-cluster-faces 10 --out " + dir + "/split"), &out),
+            0)
+      << out;
+  const auto whole = read_json(dir + "/whole/report.json")["constraints"];
+  const auto split = read_json(dir + "/split/report.json")["constraints"];
+  EXPECT_GT(split["in_force"]["curvature"].get<int>(),
+            whole["in_force"]["curvature"].get<int>() + split["curvature"].get<int>() / 4);
+  EXPECT_GE(split["clusters"].get<int>(), split["curvature"].get<int>() / 10);
+  ASSERT_EQ(test::run_command(cli("optimize --quiet --no-node-opt --max-cluster-faces 10" + files +
+                                  " --out " + dir + "/opt"),
+                              &out),
+            0)
+      << out;
+  const auto report = read_json(dir + "/opt/report.json");
+  EXPECT_EQ(report["field"]["constraints"]["in_force"]["curvature"],
+            split["in_force"]["curvature"]);
+  EXPECT_EQ(report["field"]["singularities"].get<int>(), 8);
+  EXPECT_EQ(test::run_command(
+                cli("field" + files + " --max-cluster-faces -1 --out " + dir + "/bad"), &out),
+            1)
+      << out;
+  EXPECT_NE(out.find("--max-cluster-faces"), std::string::npos) << out;
+}
+
 TEST(Cli, OptimizeWithoutNodeOptimizationWritesEverything) {
   const std::string dir = test::temp_dir("cli_optimize");
   std::string out;

@@ -352,6 +352,52 @@ TEST(CrossField, RelaxedWarmStartRoundsLikeTheLargestClusterWarmStart) {
   EXPECT_GE(multi, 2) << "the cases must exercise several clusters";
 }
 
+// Split curvature clusters (CrossFieldOptions::max_cluster_faces): on an ellipsoid whose
+// curvature regions contradict the cube layout as wholes (whole clusters are released), the
+// split clusters are released only where they contradict it, the field keeps exactly the
+// layout's singularities, and no cluster exceeds the size limit.
+TEST(CrossField, SplitCurvatureClustersStayInForceWhereTheyFitTheLayout) {
+  const auto in = test::cube_sphere(10, Vec3(2.0, 1.0, 0.75));
+  CrossFieldOptions split;
+  split.max_cluster_faces = 10;
+  const Solved whole = solve_field(in, 0, {}), parts = solve_field(in, 0, split);
+  const int curvature = whole.field.constraints.count(ConstraintKind::Curvature);
+  ASSERT_GT(curvature, 100);
+  ASSERT_EQ(parts.field.constraints.count(ConstraintKind::Curvature), curvature);
+  const ConstraintSummary a = summarize_constraints(whole.field);
+  const ConstraintSummary b = summarize_constraints(parts.field);
+  ASSERT_LT(a.in_force[0], curvature / 2) << "the case must release most with whole clusters";
+  EXPECT_GT(b.in_force[0], a.in_force[0] + curvature / 4);
+  // Every cluster has at most 10 faces: at least curvature / 10 clusters.
+  EXPECT_GE(parts.field.clusters, curvature / 10);
+  EXPECT_EQ(b.total_in_force(), parts.field.active_constraints);
+  // The layout's topology is kept exactly: the field's singularities are the nodes'.
+  const std::vector<int> target = target_quarter_indices(in.mesh, in.layout, parts.topology);
+  for (const Solved* s : {&whole, &parts})
+    for (auto v : in.mesh.vertices())
+      if (!in.mesh.is_boundary(v)) EXPECT_EQ(s->indices[v.idx()], target[v.idx()]) << v.idx();
+  // The field follows the curvature: the mean angle between the field and the principal
+  // directions (up to quarter turns) over every curvature-constrained face is smaller.
+  auto mean_deviation = [&](const Solved& s) {
+    double sum = 0;
+    int n = 0;
+    for (size_t k = 0; k < s.field.constraints.face.size(); ++k) {
+      if (s.field.constraints.kind[k] != ConstraintKind::Curvature) continue;
+      const int f = s.field.constraints.face[k];
+      const double c = s.geometry.angle_in_face(f, s.field.constraints.direction[k]);
+      sum += std::abs(std::remainder(s.field.theta[f] - c, M_PI / 2));
+      ++n;
+    }
+    return sum / n * 180 / M_PI;
+  };
+  const double dev_whole = mean_deviation(whole), dev_parts = mean_deviation(parts);
+  std::printf(
+      "[stat] split clusters: %d of %d curvature faces in force (whole clusters: %d), %d "
+      "clusters; mean deviation from the principal directions %.2f deg (whole: %.2f)\n",
+      b.in_force[0], curvature, a.in_force[0], parts.field.clusters, dev_parts, dev_whole);
+  EXPECT_LT(dev_parts, dev_whole);
+}
+
 TEST(CrossField, ConstraintSummaryCountsWhatIsInForceAndWarnsWhenMostIsReleased) {
   // On this ellipsoid the curvature clusters contradict the cube layout (see below): the
   // default drop passes release whole clusters, the face-local mode only faces near the

@@ -40,6 +40,13 @@ int main(int argc, char** argv) {
   cmd_field
       ->add_option("--sharp-angle", field.sharp_angle_deg, "Sharp feature dihedral angle (deg)")
       ->capture_default_str();
+  cmd_field
+      ->add_option("--max-cluster-faces", field.max_cluster_faces,
+                   "Curvature constraints form clusters of at most N faces, each with its own "
+                   "quarter-turn rotation, released one by one where they contradict the "
+                   "layout (0: whole connected regions)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
 
   OptimizeOptions opt;
   auto* cmd_opt = app.add_subcommand("optimize", "Run the whole pipeline and write the results");
@@ -87,6 +94,13 @@ int main(int argc, char** argv) {
           "--no-sizing", [&opt] { opt.sizing = false; }, "Unit targets, no sizing field (default)")
       ->excludes(sizing_on);
   cmd_opt->add_option("--sharp-angle", opt.sharp_angle_deg, "Sharp feature dihedral angle (deg)")
+      ->capture_default_str();
+  cmd_opt
+      ->add_option("--max-cluster-faces", opt.max_cluster_faces,
+                   "Curvature constraints form clusters of at most N faces, each with its own "
+                   "quarter-turn rotation, released one by one where they contradict the "
+                   "layout (0: whole connected regions)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd_opt
       ->add_option("--threads", opt.threads,

@@ -57,6 +57,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     const double load_s = seconds_since(t0);
     PipelineOptions options;
     options.field.constraints.sharp_angle_deg = o.sharp_angle_deg;
+    options.field.max_cluster_faces = o.max_cluster_faces;
     options.field.constraints.curvature = !o.no_align;
     if (o.sizing) options.param.sizing.enabled = *o.sizing;
     if (o.integer && !(o.quad_size > 0 || o.quad_count > 0))

@@ -76,6 +76,7 @@ int run_field(const FieldOptions& o, const CommonOptions& common) {
     const double load_s = seconds_since(t0);
     PipelineOptions options;
     options.field.constraints.sharp_angle_deg = o.sharp_angle_deg;
+    options.field.max_cluster_faces = o.max_cluster_faces;
     Pipeline pipeline(std::move(mesh), std::move(layout), options);
     report["layout"] = layout_json(pipeline.topology());
     t0 = std::chrono::steady_clock::now();

@@ -18,6 +18,7 @@ struct ValidateOptions {
 struct FieldOptions {
   std::string mesh, layout, out;
   double sharp_angle_deg = 35.0;
+  int max_cluster_faces = 0;  //!< CrossFieldOptions::max_cluster_faces
 };
 
 struct OptimizeOptions {
@@ -36,7 +37,8 @@ struct OptimizeOptions {
   //! Curl-reducing sizing field (ParamOptions::sizing); unset: the library default.
   std::optional<bool> sizing;
   double sharp_angle_deg = 35.0;
-  int threads = 1;  //!< math-library threads (core/base/solver_threads.h)
+  int max_cluster_faces = 0;  //!< CrossFieldOptions::max_cluster_faces
+  int threads = 1;            //!< math-library threads (core/base/solver_threads.h)
 };
 
 struct ImportQuadsOptions {

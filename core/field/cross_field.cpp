@@ -80,12 +80,14 @@ void CrossFieldSolver::setup(const TriMesh& mesh, const GeometryCache& g, const 
   constraint_at_.assign(nf, -1);
   for (int k = 0; k < nc; ++k) constraint_at_[field_.constraints.face[k]] = k;
   carrier_.assign(nf, 0);
+  structural_carrier_.assign(nf, 0);
   for (int k = 0; k < nc; ++k) {
     const int f = field_.constraints.face[k];
     carrier_[f] = 1;
     if (field_.constraints.kind[k] == ConstraintKind::Curvature) continue;
     for (int v : g.face_vertices[f])
-      for (auto f2 : mesh.vf_range(mesh.vertex_handle(v))) carrier_[f2.idx()] = 1;
+      for (auto f2 : mesh.vf_range(mesh.vertex_handle(v)))
+        carrier_[f2.idx()] = structural_carrier_[f2.idx()] = 1;
   }
   propagate_clusters(mesh, g, layout, topology);
   cluster_offset_.assign(field_.clusters, 0);
@@ -124,8 +126,10 @@ void CrossFieldSolver::setup(const TriMesh& mesh, const GeometryCache& g, const 
   full_matrix_ = matrix_;
   full_ = solver_;
   full_gauge_face_ = field_.gauge_face;
+  drop_structural_conflicts(mesh, g, tolerated);
   warm_start(g, /*allow_factorization=*/true);
   solve(g);
+  release_deviating_clusters(g);
   drop_conflicting_clusters(mesh, g, tolerated);
   residual_mismatches_ = count_mismatches(g);
   field_.active_constraints = nc - field_.dropped_constraints;
@@ -307,38 +311,57 @@ void CrossFieldSolver::propagate_clusters(const TriMesh& mesh, const GeometryCac
   std::vector<char> visited(nf, 0);
   std::vector<int> queue;
   queue.reserve(nf);
-  for (int k0 = 0; k0 < nc; ++k0) {
-    const int f0 = field_.constraints.face[k0];
-    if (visited[f0]) continue;
-    const int cl = static_cast<int>(cluster_size_.size());
-    cluster_size_.push_back(0);
-    visited[f0] = 1;
-    carried[f0] = c[k0];
-    queue.assign(1, f0);
-    for (size_t head = 0; head < queue.size(); ++head) {
-      const int f = queue[head];
-      const int k = constraint_at_[f];
-      if (k >= 0) {
-        relative_q_[k] = static_cast<int>(std::lround((carried[f] - c[k]) / kQuarter));
-        if (loop_of[k] >= 0) {
-          int& offset = loop_offset[loop_of[k]];
-          if (offset == INT_MIN) offset = relative_q_[k] - preset_q[k];
-          relative_q_[k] = preset_q[k] + offset;
+  const bool split = options_.max_cluster_faces > 0;
+  // Split mode, first the feature and boundary clusters (their rings carry the angle between
+  // their constraints, algorithm.md §3.2, also across faces with curvature constraints), then
+  // the curvature clusters over the curvature-constrained faces, each of at most
+  // max_cluster_faces faces. Otherwise one pass: connected regions of every kind.
+  auto is_curvature = [&](int k) {
+    return field_.constraints.kind[k] == ConstraintKind::Curvature;
+  };
+  for (int phase = 0; phase < (split ? 2 : 1); ++phase) {
+    const bool curvature_phase = split && phase == 1;
+    if (split) std::fill(visited.begin(), visited.end(), 0);
+    for (int k0 = 0; k0 < nc; ++k0) {
+      const int f0 = field_.constraints.face[k0];
+      if (split && (cluster_of_[k0] >= 0 || is_curvature(k0) != curvature_phase)) continue;
+      if (visited[f0]) continue;
+      const int cl = static_cast<int>(cluster_size_.size());
+      cluster_size_.push_back(0);
+      visited[f0] = 1;
+      carried[f0] = c[k0];
+      queue.assign(1, f0);
+      for (size_t head = 0; head < queue.size(); ++head) {
+        const int f = queue[head];
+        const int k = constraint_at_[f];
+        if (k >= 0 && (!split || is_curvature(k) == curvature_phase)) {
+          relative_q_[k] = static_cast<int>(std::lround((carried[f] - c[k]) / kQuarter));
+          if (loop_of[k] >= 0) {
+            int& offset = loop_offset[loop_of[k]];
+            if (offset == INT_MIN) offset = relative_q_[k] - preset_q[k];
+            relative_q_[k] = preset_q[k] + offset;
+          }
+          carried[f] = c[k] + kQuarter * relative_q_[k];
+          cluster_of_[k] = cl;
+          ++cluster_size_[cl];
         }
-        carried[f] = c[k] + kQuarter * relative_q_[k];
-        cluster_of_[k] = cl;
-        ++cluster_size_[cl];
-      }
-      for (auto h : mesh.fh_range(mesh.face_handle(f))) {
-        const auto opp = mesh.opposite_halfedge_handle(h);
-        if (mesh.is_boundary(opp)) continue;
-        const int f2 = mesh.face_handle(opp).idx();
-        if (visited[f2] || !carrier_[f2]) continue;
-        const int e = mesh.edge_handle(h).idx();
-        const double step = g.kappa[e] + kQuarter * field_.period_jump[e];
-        carried[f2] = (g.edge_face_i[e] == f) ? carried[f] + step : carried[f] - step;
-        visited[f2] = 1;
-        queue.push_back(f2);
+        for (auto h : mesh.fh_range(mesh.face_handle(f))) {
+          const auto opp = mesh.opposite_halfedge_handle(h);
+          if (mesh.is_boundary(opp)) continue;
+          const int f2 = mesh.face_handle(opp).idx();
+          if (visited[f2] || !carrier_[f2]) continue;
+          if (split && !curvature_phase && !structural_carrier_[f2]) continue;
+          if (curvature_phase) {
+            const int k2 = constraint_at_[f2];
+            if (k2 < 0 || !is_curvature(k2) || cluster_of_[k2] >= 0) continue;
+            if (cluster_size_[cl] >= options_.max_cluster_faces) continue;
+          }
+          const int e = mesh.edge_handle(h).idx();
+          const double step = g.kappa[e] + kQuarter * field_.period_jump[e];
+          carried[f2] = (g.edge_face_i[e] == f) ? carried[f] + step : carried[f] - step;
+          visited[f2] = 1;
+          queue.push_back(f2);
+        }
       }
     }
   }
@@ -346,6 +369,7 @@ void CrossFieldSolver::propagate_clusters(const TriMesh& mesh, const GeometryCac
 }
 
 void CrossFieldSolver::warm_start(const GeometryCache& g, bool allow_factorization) {
+  reference_theta_.resize(0);
   if (field_.clusters <= 1) return;
   const auto t0 = std::chrono::steady_clock::now();
   const double factorize_before = field_.timings.factorize_s;
@@ -372,6 +396,10 @@ void CrossFieldSolver::warm_start(const GeometryCache& g, bool allow_factorizati
                             static_cast<double>(others.size()) * g.n_faces <= 8e6;
   ClusterWarmStart mode = options_.warm_start;
   if (mode == ClusterWarmStart::Relaxed && !relaxed_fits) mode = ClusterWarmStart::LayoutField;
+  // Split curvature clusters are judged against the layout's own field
+  // (release_deviating_clusters): it is the warm start then.
+  if (options_.max_cluster_faces > 0 && options_.max_cluster_deviation_deg > 0)
+    mode = ClusterWarmStart::LayoutField;
   if (mode == ClusterWarmStart::LayoutField && arc_gauge_face_ < 0)
     mode = ClusterWarmStart::LargestCluster;  // no arc to pin the reference field along
   if (mode == ClusterWarmStart::LayoutField) {
@@ -405,6 +433,7 @@ void CrossFieldSolver::warm_start(const GeometryCache& g, bool allow_factorizati
     if (!same_face) reference.array() += arc_gauge_angle_ - reference(arc_gauge_face_);
     std::fill(cluster_offset_.begin(), cluster_offset_.end(), 0);
     round_clusters(c, reference);
+    reference_theta_ = std::move(reference);
     field_.timings.warm_start_s +=
         seconds_since(t0) - (field_.timings.factorize_s - factorize_before);
     return;
@@ -605,6 +634,114 @@ void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const Geom
   field_.timings.conflicts_s += seconds_since(t0) - (field_.timings.factorize_s - factorize_before);
 }
 
+void CrossFieldSolver::drop_structural_conflicts(const TriMesh& mesh, const GeometryCache& g,
+                                                 int tolerated) {
+  const int nc = static_cast<int>(field_.constraints.face.size());
+  if (options_.max_cluster_faces <= 0 || nc == 0 || options_.max_conflict_passes <= 0) return;
+  // Curvature clusters in force (split mode: a cluster has constraints of one class only).
+  std::vector<char> curvature(field_.clusters, 0);
+  bool any_structural = false;
+  for (int k = 0; k < nc; ++k) {
+    if (!active(k)) continue;
+    if (curvature_class(k))
+      curvature[cluster_of_[k]] = 1;
+    else
+      any_structural = true;
+  }
+  if (!any_structural || std::find(curvature.begin(), curvature.end(), 1) == curvature.end())
+    return;
+  const double lambda = options_.constraint_weight;
+  const int gauge_before = field_.gauge_face;
+  const double gauge_angle_before = gauge_angle_;
+  std::vector<int> lifted;  // curvature constraints set aside
+  for (int k = 0; k < nc; ++k) {
+    if (!active(k) || !curvature[cluster_of_[k]]) continue;
+    const int f = field_.constraints.face[k];
+    matrix_.coeffRef(f, f) -= lambda;
+    lifted.push_back(k);
+  }
+  for (int cl = 0; cl < field_.clusters; ++cl)
+    if (curvature[cl]) cluster_active_[cl] = 0;
+  factorize(spare_, matrix_);
+  std::swap(solver_, spare_);
+  solve(g);
+  drop_conflicting_clusters(mesh, g, tolerated);
+  // The curvature clusters back in force (their λ), a gauge the passes may have pinned removed.
+  for (int cl = 0; cl < field_.clusters; ++cl)
+    if (curvature[cl]) cluster_active_[cl] = 1;
+  for (int k : lifted) {
+    const int f = field_.constraints.face[k];
+    matrix_.coeffRef(f, f) += lambda;
+  }
+  if (field_.gauge_face != gauge_before) {
+    if (field_.gauge_face >= 0) matrix_.coeffRef(field_.gauge_face, field_.gauge_face) -= lambda;
+    field_.gauge_face = gauge_before;
+    gauge_angle_ = gauge_angle_before;
+  }
+  std::vector<char> any_active(field_.clusters, 0);
+  for (int k = 0; k < nc; ++k)
+    if (active(k)) any_active[cluster_of_[k]] = 1;
+  field_.dropped_clusters = 0;
+  for (int cl = 0; cl < field_.clusters; ++cl) field_.dropped_clusters += !any_active[cl];
+  factorize(spare_, matrix_);
+  std::swap(solver_, spare_);
+}
+
+void CrossFieldSolver::release_deviating_clusters(const GeometryCache& g) {
+  const int nc = static_cast<int>(field_.constraints.face.size());
+  if (options_.max_cluster_faces <= 0 || options_.max_cluster_deviation_deg <= 0 ||
+      reference_theta_.size() != g.n_faces || nc == 0)
+    return;
+  const auto t0 = std::chrono::steady_clock::now();
+  const double factorize_before = field_.timings.factorize_s;
+  // Mean angle (radians, 0..π/4) between each curvature cluster's targets (its current
+  // rotation) and the layout's own field, up to quarter turns.
+  const std::vector<double> c = constraint_angles(g);
+  std::vector<double> sum(field_.clusters, 0.0);
+  std::vector<int> count(field_.clusters, 0);
+  for (int k = 0; k < nc; ++k) {
+    if (!active(k) || !curvature_class(k)) continue;
+    const int cl = cluster_of_[k];
+    const double target = c[k] + kQuarter * (relative_q_[k] + cluster_offset_[cl]);
+    sum[cl] +=
+        std::abs(std::remainder(reference_theta_(field_.constraints.face[k]) - target, kQuarter));
+    ++count[cl];
+  }
+  const double limit = options_.max_cluster_deviation_deg * M_PI / 180.0;
+  const double lambda = options_.constraint_weight;
+  bool released = false;
+  for (int cl = 0; cl < field_.clusters; ++cl) {
+    if (count[cl] == 0 || sum[cl] / count[cl] <= limit) continue;
+    cluster_active_[cl] = 0;
+    released = true;
+  }
+  if (!released) return;
+  bool any_left = false;
+  std::vector<char> any_active(field_.clusters, 0);
+  for (int k = 0; k < nc; ++k) {
+    if (cluster_active_[cluster_of_[k]]) {
+      any_left = any_left || constraint_active_[k];
+      any_active[cluster_of_[k]] = any_active[cluster_of_[k]] || constraint_active_[k];
+      continue;
+    }
+    if (count[cluster_of_[k]] == 0 || !constraint_active_[k]) continue;  // dropped before
+    const int f = field_.constraints.face[k];
+    matrix_.coeffRef(f, f) -= lambda;
+    ++field_.dropped_constraints;
+  }
+  if (!any_left && field_.gauge_face < 0) {  // as drop_conflicting_clusters
+    field_.gauge_face = field_.constraints.face[0];
+    gauge_angle_ = field_.theta[field_.gauge_face];
+    matrix_.coeffRef(field_.gauge_face, field_.gauge_face) += lambda;
+  }
+  field_.dropped_clusters = 0;
+  for (int cl = 0; cl < field_.clusters; ++cl) field_.dropped_clusters += !any_active[cl];
+  factorize(spare_, matrix_);
+  std::swap(solver_, spare_);
+  solve(g);
+  field_.timings.conflicts_s += seconds_since(t0) - (field_.timings.factorize_s - factorize_before);
+}
+
 double CrossFieldSolver::energy(const GeometryCache& g) const {
   double e = 0;
   for (int edge = 0; edge < g.n_edges; ++edge) {
@@ -738,8 +875,10 @@ const CrossField& CrossFieldSolver::update_layout(const TriMesh& mesh, const Geo
     field_.dropped_clusters = 0;
     field_.gauge_face = full_gauge_face_;
   }
+  drop_structural_conflicts(mesh, g, residual_mismatches_);
   warm_start(g, /*allow_factorization=*/false);
   solve(g);
+  release_deviating_clusters(g);
   // Clusters that contradict the new layout (steps across edges that disagree with the new
   // period jumps) are dropped as in the constructor; this factorizes only when there are any.
   // As many mismatches as the constructor's passes left (the smoothest field itself turns by

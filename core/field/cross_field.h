@@ -53,6 +53,27 @@ struct CrossFieldOptions {
   int max_conflict_passes = 6;
   int conflict_rings = 6;
   ConflictDrop conflict_drop = ConflictDrop::Clusters;
+  //! Split mode (> 0): the curvature constraints form clusters of at most this many faces,
+  //! grown breadth-first, each with its own free quarter-turn rotation; the feature and
+  //! boundary constraints keep whole clusters along their rings (which carry the angle across
+  //! curvature-constrained faces too) and their conflicts are settled first, as in a run
+  //! without curvature constraints (drop_structural_conflicts). 0 (default): one cluster per
+  //! connected region of constrained faces of any kind.
+  //! With whole regions one rotation must suit a region that crosses the layout's
+  //! singularities, so the conflict passes release whole regions: cage layouts kept 0.2–13 %
+  //! of their curvature constraints and the aligned run barely differed from --no-align. Split
+  //! clusters are released only where they contradict the layout. At 10, on layouts that
+  //! follow the curvature (the QuadWild joint) and on most cage layouts the aligned E° falls
+  //! below --no-align's with fewer fold-overs; on layouts that do not follow the curvature
+  //! (inspired_mesh's conjugate-direction layout) the kept clusters twist the field against
+  //! the arcs (E 2.7× higher, not embeddable after node optimization), hence opt-in.
+  //! docs/benchmarks.md, session 14. (`--max-cluster-faces`)
+  int max_cluster_faces = 0;
+  //! Split mode: a curvature cluster whose targets deviate from the layout's own field (the
+  //! smoothest field with the layout's singularities, the warm start in split mode) by more
+  //! than this mean angle (degrees, up to quarter turns; 45 at most) is released before the
+  //! conflict passes. ≤ 0: off.
+  double max_cluster_deviation_deg = 30.0;
 };
 
 //! Wall-clock seconds of the field stage's parts and operation counts (see bench/field_bench).
@@ -167,6 +188,14 @@ class CrossFieldSolver {
   //! ones the passes could not remove before).
   void drop_conflicting_clusters(const TriMesh& mesh, const GeometryCache& geometry,
                                  int tolerated = 0);
+  //! Split mode (max_cluster_faces > 0): the conflict passes for the feature and boundary
+  //! clusters alone, as a run without curvature constraints does them, before the curvature
+  //! clusters come back into force (two factorizations). Otherwise the curvature clusters next
+  //! to a feature or boundary cluster that contradicts the layout were released in its stead.
+  void drop_structural_conflicts(const TriMesh& mesh, const GeometryCache& geometry, int tolerated);
+  //! Releases the curvature clusters that deviate from the layout's own field
+  //! (CrossFieldOptions::max_cluster_deviation_deg; one factorization when any is released).
+  void release_deviating_clusters(const GeometryCache& geometry);
   //! Interior edges whose principal matching differs from the period jump.
   int count_mismatches(const GeometryCache& geometry) const;
   //! The energy the solve minimizes, at field_.theta: Σ over interior edges of the squared
@@ -179,8 +208,10 @@ class CrossFieldSolver {
   //! moved vertices).
   CurvatureCache curvature_cache_;
   CrossField field_;
-  std::vector<int> constraint_at_;       //!< per face: constraint index or -1
-  std::vector<char> carrier_;            //!< per face: carries the angle between constraints
+  std::vector<int> constraint_at_;  //!< per face: constraint index or -1
+  std::vector<char> carrier_;       //!< per face: carries the angle between constraints
+  //! per face: on the ring of a feature or boundary constraint (a carrier for those kinds)
+  std::vector<char> structural_carrier_;
   std::vector<int> cluster_size_;        //!< per cluster: constrained faces
   std::vector<int> cluster_of_;          //!< per constraint
   std::vector<int> relative_q_;          //!< per constraint, within its cluster
@@ -188,6 +219,10 @@ class CrossFieldSolver {
   std::vector<char> cluster_active_;     //!< per cluster: 0 once dropped as contradictory
   std::vector<char> constraint_active_;  //!< per constraint: 0 once dropped
   bool active(int k) const { return cluster_active_[cluster_of_[k]] && constraint_active_[k]; }
+  //! A curvature constraint (split mode: in a curvature cluster).
+  bool curvature_class(int k) const {
+    return field_.constraints.kind[k] == ConstraintKind::Curvature;
+  }
   std::vector<Vec3> constraint_dir_;  //!< original 3D directions
   double gauge_angle_ = 0;
   int arc_gauge_face_ = -1;     //!< face along the middle of the longest arc
@@ -201,6 +236,8 @@ class CrossFieldSolver {
   //! pinned at reference_face_ (kept for update_layout).
   SpdSolver reference_{"cross field"};
   int reference_face_ = -1;
+  //! The layout's own field of the last LayoutField warm start (empty otherwise), per face.
+  Eigen::VectorXd reference_theta_;
   int residual_mismatches_ = 0;  //!< mismatching edges left by the constructor's drop passes
   //! The constructor's matrix and factorization with every constraint in force (before drop
   //! passes), and its gauge face: update_layout starts from them.
