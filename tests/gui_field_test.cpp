@@ -82,6 +82,17 @@ TEST(GuiField, SnapshotMarksReleasedConstraintsAndWarns) {
   EXPECT_GT(field.dropped_clusters, 0);
   EXPECT_LE(field.dropped_clusters, field.clusters);
   EXPECT_NE(field.warning.find("released"), std::string::npos) << field.warning;
+  // The panel's "Cluster size" (split curvature clusters) reaches the job: more in force.
+  WorkerOptions split;
+  split.max_cluster_faces = 10;
+  const auto p = solve_once(ex, split);
+  ASSERT_EQ(p->status, WorkerStatus::Finished) << p->message;
+  ASSERT_TRUE(p->field);
+  ASSERT_EQ(p->field->constraint_faces.size(), field.constraint_faces.size());
+  int split_in_force = 0;
+  for (char c : p->field->constraint_in_force) split_in_force += c != 0;
+  EXPECT_GT(split_in_force, in_force + static_cast<int>(field.constraint_faces.size()) / 4);
+  EXPECT_GT(p->field->clusters, field.clusters);
   // Without constraints (the bundled example at the default thresholds) there is no warning.
   const auto e = solve_once(example(), WorkerOptions{});
   ASSERT_TRUE(e->field);

@@ -386,6 +386,16 @@ void App::draw_pipeline_options() {
     o.sharp_angle_deg = sharp;
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("Edges with a dihedral angle above this are features (--sharp-angle)");
+  if (!o.align) ImGui::BeginDisabled();
+  ImGui::SliderInt("Cluster size", &o.max_cluster_faces, 0, 100,
+                   o.max_cluster_faces ? "%d" : "off");
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip(
+        "Split the curvature constraints into clusters of at most this many faces, released one "
+        "by one where they contradict the layout (0: whole connected regions). 10 keeps far more "
+        "in force on layouts that roughly follow the curvature; on layouts that do not, it "
+        "twists the field against the arcs (--max-cluster-faces)");
+  if (!o.align) ImGui::EndDisabled();
   float anisotropy = float(o.anisotropy);
   if (ImGui::SliderFloat("Anisotropy", &anisotropy, 1.0f, 100.0f, "%.1f",
                          ImGuiSliderFlags_Logarithmic))
@@ -418,6 +428,7 @@ void App::draw_pipeline_options() {
   // Clamp typed values (Ctrl+click) to what the pipeline accepts.
   o.sharp_angle_deg = std::clamp(o.sharp_angle_deg, 1.0, 180.0);
   o.anisotropy = std::clamp(o.anisotropy, 1.0, 1000.0);
+  o.max_cluster_faces = std::clamp(o.max_cluster_faces, 0, 100000);
   o.max_steps = std::clamp(o.max_steps, 1, 10000);
   o.descent_steps = std::clamp(o.descent_steps, 0, 10000);
   o.alpha = std::clamp(o.alpha, 0.01, 1.0);
@@ -425,6 +436,7 @@ void App::draw_pipeline_options() {
     const WorkerOptions defaults;
     o.align = defaults.align;
     o.sharp_angle_deg = defaults.sharp_angle_deg;
+    o.max_cluster_faces = defaults.max_cluster_faces;
     o.anisotropy = defaults.anisotropy;
     o.node_optimization = defaults.node_optimization;
     o.max_steps = defaults.max_steps;

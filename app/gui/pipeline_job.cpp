@@ -70,6 +70,7 @@ PipelineOptions pipeline_options(const WorkerOptions& o) {
   PipelineOptions options;
   options.field.constraints.curvature = o.align;
   options.field.constraints.sharp_angle_deg = o.sharp_angle_deg;
+  options.field.max_cluster_faces = o.max_cluster_faces;
   options.param.anisotropy = o.anisotropy;
   return options;
 }

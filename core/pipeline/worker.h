@@ -40,6 +40,8 @@ struct WorkerOptions {
   // Pipeline settings of a job (as `quadsketch-cli optimize`); a job keeps those it started with.
   bool align = true;              //!< false: ignore curvature directions (--no-align)
   double sharp_angle_deg = 35.0;  //!< sharp feature dihedral angle (--sharp-angle)
+  //! Split curvature clusters of at most this many faces (--max-cluster-faces; 0: off)
+  int max_cluster_faces = 0;
   double anisotropy = 10.0;       //!< anisotropic norm factor of the parameterization energy
   double alpha = 0.75;            //!< initial damping α of node-optimization steps
   int descent_steps = 25;         //!< descent steps before the first hop sweep (--steps)
