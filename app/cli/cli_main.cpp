@@ -53,7 +53,10 @@ int main(int argc, char** argv) {
   cmd_opt->add_option("--mesh", opt.mesh, "Triangle mesh")->required();
   cmd_opt->add_option("--layout", opt.layout, "Layout JSON")->required();
   cmd_opt->add_option("--out", opt.out, "Output folder")->required();
-  cmd_opt->add_option("--steps", opt.steps, "Maximum number of node optimization steps")
+  cmd_opt
+      ->add_option("--steps", opt.steps,
+                   "Node optimization descent steps (accepted and rejected) before the first hop "
+                   "sweep; a sweep that moves nodes allows at least 10 more (3 sweeps at most)")
       ->capture_default_str();
   cmd_opt->add_flag("--no-node-opt", opt.no_node_opt, "Only field and parameterization");
   auto* quad_size_opt =
