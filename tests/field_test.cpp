@@ -321,6 +321,37 @@ TEST(CrossField, UpdateLayoutEqualsAFreshSolver) {
   EXPECT_EQ(std::count(idx.begin(), idx.end(), 0), static_cast<long>(idx.size()) - 8);
 }
 
+TEST(CrossField, UpdateLayoutEqualsAFreshSolverWithSplitClusters) {
+  // The same with split curvature clusters on an ellipsoid where some are released: the
+  // update (the structural pass, the deviation release and the conflict passes again) gives
+  // the fresh solver's clusters, rotations, releases and field.
+  const auto in = test::cube_sphere(10, Vec3(2.0, 1.0, 0.75));
+  CrossFieldOptions split;
+  split.max_cluster_faces = 10;
+  const GeometryCache g = build_geometry(in.mesh);
+  const LayoutTopology topo = build_topology(in.mesh, in.layout);
+  CrossFieldSolver solver(in.mesh, g, in.layout, topo, split);
+  ASSERT_GT(solver.field().clusters, 10);
+  PerturbLayoutOptions popt;
+  popt.rings = 2;
+  popt.seed = 3;
+  const PerturbResult moved = perturb_layout(in.mesh, in.layout, popt);
+  ASSERT_GE(moved.moved_nodes.size(), 4u);
+  const LayoutTopology topo2 = build_topology(in.mesh, moved.layout);
+  const CrossField& updated = solver.update_layout(in.mesh, g, moved.layout, topo2);
+  const CrossFieldSolver fresh(in.mesh, g, moved.layout, topo2, split);
+  EXPECT_EQ(updated.clusters, fresh.field().clusters);
+  EXPECT_EQ(updated.period_jump, fresh.field().period_jump);
+  EXPECT_EQ(updated.constraint_active, fresh.field().constraint_active);
+  EXPECT_EQ(updated.constraint_q, fresh.field().constraint_q);
+  EXPECT_EQ(updated.dropped_clusters, fresh.field().dropped_clusters);
+  EXPECT_LT(max_difference(updated.theta, fresh.field().theta), 1e-9);
+  const auto idx = field_quarter_indices(g, updated.theta);
+  for (const auto& node : moved.layout.nodes) EXPECT_EQ(idx[node.vertex], 1);
+  EXPECT_GT(fresh.field().dropped_clusters, 0) << "the case should release some clusters";
+  EXPECT_GT(fresh.field().active_constraints, 0);
+}
+
 TEST(CrossField, RelaxedWarmStartRoundsLikeTheLargestClusterWarmStart) {
   // The relaxed warm start (no extra factorization) must pick the same cluster rotations as
   // the largest-cluster warm start on models with several constraint clusters.
