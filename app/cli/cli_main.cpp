@@ -32,6 +32,16 @@ int main(int argc, char** argv) {
   cmd_validate->add_option("--layout", validate.layout, "Layout JSON")->required();
   cmd_validate->add_option("--out", validate.out, "Also write report.json into this folder");
 
+  // field and optimize: CrossFieldOptions::max_cluster_faces.
+  auto add_cluster_option = [](CLI::App* cmd, int& value) {
+    cmd->add_option("--max-cluster-faces", value,
+                    "Curvature constraints form clusters of at most N faces, each with its own "
+                    "quarter-turn rotation, released one by one where they contradict the "
+                    "layout (0: whole connected regions)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+  };
+
   FieldOptions field;
   auto* cmd_field = app.add_subcommand("field", "Compute the guiding cross field of a layout");
   cmd_field->add_option("--mesh", field.mesh, "Triangle mesh")->required();
@@ -40,13 +50,7 @@ int main(int argc, char** argv) {
   cmd_field
       ->add_option("--sharp-angle", field.sharp_angle_deg, "Sharp feature dihedral angle (deg)")
       ->capture_default_str();
-  cmd_field
-      ->add_option("--max-cluster-faces", field.max_cluster_faces,
-                   "Curvature constraints form clusters of at most N faces, each with its own "
-                   "quarter-turn rotation, released one by one where they contradict the "
-                   "layout (0: whole connected regions)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
+  add_cluster_option(cmd_field, field.max_cluster_faces);
 
   OptimizeOptions opt;
   auto* cmd_opt = app.add_subcommand("optimize", "Run the whole pipeline and write the results");
@@ -98,13 +102,7 @@ int main(int argc, char** argv) {
       ->excludes(sizing_on);
   cmd_opt->add_option("--sharp-angle", opt.sharp_angle_deg, "Sharp feature dihedral angle (deg)")
       ->capture_default_str();
-  cmd_opt
-      ->add_option("--max-cluster-faces", opt.max_cluster_faces,
-                   "Curvature constraints form clusters of at most N faces, each with its own "
-                   "quarter-turn rotation, released one by one where they contradict the "
-                   "layout (0: whole connected regions)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
+  add_cluster_option(cmd_opt, opt.max_cluster_faces);
   cmd_opt
       ->add_option("--threads", opt.threads,
                    "Threads of the math libraries (OpenBLAS, CHOLMOD's OpenMP regions); more "
