@@ -64,7 +64,7 @@ struct CrossFieldOptions {
   //! of their curvature constraints and the aligned run barely differed from --no-align. Split
   //! clusters are released only where they contradict the layout. At 10, on layouts that
   //! follow the curvature (the QuadWild joint) and on most cage layouts the aligned E° falls
-  //! below --no-align's with fewer fold-overs; on layouts that do not follow the curvature
+  //! below --no-align's (fold-overs vary); on layouts that do not follow the curvature
   //! (inspired_mesh's conjugate-direction layout) the kept clusters twist the field against
   //! the arcs (E 2.7× higher, not embeddable after node optimization), hence opt-in.
   //! docs/benchmarks.md, session 14. (`--max-cluster-faces`)
