@@ -406,7 +406,9 @@ TEST(CrossField, SplitCurvatureClustersStayInForceWhereTheyFitTheLayout) {
   const std::vector<int> target = target_quarter_indices(in.mesh, in.layout, parts.topology);
   for (const Solved* s : {&whole, &parts})
     for (auto v : in.mesh.vertices())
-      if (!in.mesh.is_boundary(v)) EXPECT_EQ(s->indices[v.idx()], target[v.idx()]) << v.idx();
+      if (!in.mesh.is_boundary(v)) {
+        EXPECT_EQ(s->indices[v.idx()], target[v.idx()]) << v.idx();
+      }
   // The field follows the curvature: the mean angle between the field and the principal
   // directions (up to quarter turns) over every curvature-constrained face is smaller.
   auto mean_deviation = [&](const Solved& s) {
