@@ -290,6 +290,14 @@ TEST(CrossField, ResolveAfterMovingVerticesEqualsAFreshSolve) {
   EXPECT_EQ(std::count(idx.begin(), idx.end(), 0), static_cast<long>(idx.size()) - 8);
 }
 
+// The layout's nodes moved by 2 rings (seed 3): the update_layout cases.
+PerturbResult moved_by_two_rings(const test::MeshAndLayout& in) {
+  PerturbLayoutOptions popt;
+  popt.rings = 2;
+  popt.seed = 3;
+  return perturb_layout(in.mesh, in.layout, popt);
+}
+
 TEST(CrossField, UpdateLayoutEqualsAFreshSolver) {
   // Nodes moved to other vertices (arcs re-routed): new period jumps, same matrix. The updated
   // solver must give exactly what a solver built for the new layout gives.
@@ -298,10 +306,7 @@ TEST(CrossField, UpdateLayoutEqualsAFreshSolver) {
   const LayoutTopology topo = build_topology(in.mesh, in.layout);
   CrossFieldSolver solver(in.mesh, g, in.layout, topo);
   ASSERT_GT(solver.field().constraints.face.size(), 100u);
-  PerturbLayoutOptions popt;
-  popt.rings = 2;
-  popt.seed = 3;
-  const PerturbResult moved = perturb_layout(in.mesh, in.layout, popt);
+  const PerturbResult moved = moved_by_two_rings(in);
   ASSERT_GE(moved.moved_nodes.size(), 4u);
   const LayoutTopology topo2 = build_topology(in.mesh, moved.layout);
   const int factorizations = solver.field().timings.factorizations;
@@ -332,10 +337,7 @@ TEST(CrossField, UpdateLayoutEqualsAFreshSolverWithSplitClusters) {
   const LayoutTopology topo = build_topology(in.mesh, in.layout);
   CrossFieldSolver solver(in.mesh, g, in.layout, topo, split);
   ASSERT_GT(solver.field().clusters, 10);
-  PerturbLayoutOptions popt;
-  popt.rings = 2;
-  popt.seed = 3;
-  const PerturbResult moved = perturb_layout(in.mesh, in.layout, popt);
+  const PerturbResult moved = moved_by_two_rings(in);
   ASSERT_GE(moved.moved_nodes.size(), 4u);
   const LayoutTopology topo2 = build_topology(in.mesh, moved.layout);
   const CrossField& updated = solver.update_layout(in.mesh, g, moved.layout, topo2);

@@ -170,6 +170,34 @@ void CrossFieldSolver::factorize(SpdSolver& solver, const Eigen::SparseMatrix<do
   ++field_.timings.factorizations;
 }
 
+void CrossFieldSolver::factorize_as_current() {
+  factorize(spare_, matrix_);
+  std::swap(solver_, spare_);
+}
+
+void CrossFieldSolver::pin_gauge_if_unconstrained() {
+  if (field_.gauge_face >= 0) return;
+  for (int k = 0; k < static_cast<int>(field_.constraints.face.size()); ++k)
+    if (active(k)) return;
+  // Nothing left to fix the global rotation on a closed surface: pin one face (it is re-chosen
+  // to minimize the energy by the parameterization stage).
+  field_.gauge_face = field_.constraints.face[0];
+  gauge_angle_ = field_.theta[field_.gauge_face];
+  matrix_.coeffRef(field_.gauge_face, field_.gauge_face) += options_.constraint_weight;
+}
+
+void CrossFieldSolver::recount_dropped_clusters() {
+  // A cluster counts as dropped when none of its constraints is in force any more.
+  std::vector<char> any_active(field_.clusters, 0);
+  for (int k = 0; k < static_cast<int>(field_.constraints.face.size()); ++k)
+    if (active(k)) any_active[cluster_of_[k]] = 1;
+  field_.dropped_clusters = 0;
+  for (int cl = 0; cl < field_.clusters; ++cl) {
+    cluster_active_[cl] = any_active[cl];
+    field_.dropped_clusters += !any_active[cl];
+  }
+}
+
 Eigen::VectorXd CrossFieldSolver::back_substitute(const Eigen::VectorXd& b) {
   ++field_.timings.solves;
   return solver_.solve(b);
@@ -316,9 +344,6 @@ void CrossFieldSolver::propagate_clusters(const TriMesh& mesh, const GeometryCac
   // their constraints, algorithm.md §3.2, also across faces with curvature constraints), then
   // the curvature clusters over the curvature-constrained faces, each of at most
   // max_cluster_faces faces. Otherwise one pass: connected regions of every kind.
-  auto is_curvature = [&](int k) {
-    return field_.constraints.kind[k] == ConstraintKind::Curvature;
-  };
   for (int phase = 0; phase < (split ? 2 : 1); ++phase) {
     const bool curvature_phase = split && phase == 1;
     if (split) std::fill(visited.begin(), visited.end(), 0);
@@ -561,19 +586,10 @@ void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const Geom
     field_.dropped_constraints += static_cast<int>(removed.size());
     const int gauge_before = field_.gauge_face;
     const double gauge_angle_before = gauge_angle_;
-    bool any_left = false;
-    for (int k = 0; k < nc && !any_left; ++k) any_left = active(k);
-    if (!any_left && field_.gauge_face < 0) {
-      // Nothing left to fix the global rotation on a closed surface: pin one face (it is
-      // re-chosen to minimize the energy by the parameterization stage).
-      field_.gauge_face = field_.constraints.face[0];
-      gauge_angle_ = field_.theta[field_.gauge_face];
-      matrix_.coeffRef(field_.gauge_face, field_.gauge_face) += lambda;
-    }
+    pin_gauge_if_unconstrained();
     // The trial's solve re-rounds the cluster offsets: kept for the restore below.
     const std::vector<int> offsets_before = cluster_offset_;
-    factorize(spare_, matrix_);
-    std::swap(solver_, spare_);
+    factorize_as_current();
     solve(g);
     ++field_.timings.conflict_passes;
     const int now = count_mismatches(g);
@@ -622,15 +638,7 @@ void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const Geom
     for (int cl : drop) in_drop[cl] = 0;
     mismatches = now;
   }
-  // A cluster counts as dropped when none of its constraints is in force any more.
-  std::vector<char> any_active(field_.clusters, 0);
-  for (int k = 0; k < nc; ++k)
-    if (active(k)) any_active[cluster_of_[k]] = 1;
-  field_.dropped_clusters = 0;
-  for (int cl = 0; cl < field_.clusters; ++cl) {
-    cluster_active_[cl] = any_active[cl];
-    field_.dropped_clusters += !any_active[cl];
-  }
+  recount_dropped_clusters();
   field_.timings.conflicts_s += seconds_since(t0) - (field_.timings.factorize_s - factorize_before);
 }
 
@@ -643,7 +651,7 @@ void CrossFieldSolver::drop_structural_conflicts(const TriMesh& mesh, const Geom
   bool any_structural = false;
   for (int k = 0; k < nc; ++k) {
     if (!active(k)) continue;
-    if (curvature_class(k))
+    if (is_curvature(k))
       curvature[cluster_of_[k]] = 1;
     else
       any_structural = true;
@@ -653,7 +661,11 @@ void CrossFieldSolver::drop_structural_conflicts(const TriMesh& mesh, const Geom
   const double lambda = options_.constraint_weight;
   const int gauge_before = field_.gauge_face;
   const double gauge_angle_before = gauge_angle_;
-  std::vector<int> lifted;  // curvature constraints set aside
+  const int dropped_before = field_.dropped_constraints;
+  // The state to come back to when no feature or boundary constraint is dropped.
+  const Eigen::SparseMatrix<double> matrix_before = matrix_;
+  const SpdSolver solver_before = solver_;  // shares the factorization (copy-on-write)
+  std::vector<int> lifted;                  // curvature constraints set aside
   for (int k = 0; k < nc; ++k) {
     if (!active(k) || !curvature[cluster_of_[k]]) continue;
     const int f = field_.constraints.face[k];
@@ -662,29 +674,29 @@ void CrossFieldSolver::drop_structural_conflicts(const TriMesh& mesh, const Geom
   }
   for (int cl = 0; cl < field_.clusters; ++cl)
     if (curvature[cl]) cluster_active_[cl] = 0;
-  factorize(spare_, matrix_);
-  std::swap(solver_, spare_);
+  factorize_as_current();
   solve(g);
   drop_conflicting_clusters(mesh, g, tolerated);
-  // The curvature clusters back in force (their λ), a gauge the passes may have pinned removed.
+  // The curvature clusters back in force.
   for (int cl = 0; cl < field_.clusters; ++cl)
     if (curvature[cl]) cluster_active_[cl] = 1;
-  for (int k : lifted) {
-    const int f = field_.constraints.face[k];
-    matrix_.coeffRef(f, f) += lambda;
+  if (field_.dropped_constraints == dropped_before) {
+    // Nothing dropped: the matrix and factorization from before (no second factorization).
+    matrix_ = matrix_before;
+    solver_ = solver_before;
+  } else {
+    for (int k : lifted) {
+      const int f = field_.constraints.face[k];
+      matrix_.coeffRef(f, f) += lambda;
+    }
+    // A gauge the passes pinned when nothing was left in force is not needed any more.
+    if (field_.gauge_face != gauge_before && field_.gauge_face >= 0)
+      matrix_.coeffRef(field_.gauge_face, field_.gauge_face) -= lambda;
+    factorize_as_current();
   }
-  if (field_.gauge_face != gauge_before) {
-    if (field_.gauge_face >= 0) matrix_.coeffRef(field_.gauge_face, field_.gauge_face) -= lambda;
-    field_.gauge_face = gauge_before;
-    gauge_angle_ = gauge_angle_before;
-  }
-  std::vector<char> any_active(field_.clusters, 0);
-  for (int k = 0; k < nc; ++k)
-    if (active(k)) any_active[cluster_of_[k]] = 1;
-  field_.dropped_clusters = 0;
-  for (int cl = 0; cl < field_.clusters; ++cl) field_.dropped_clusters += !any_active[cl];
-  factorize(spare_, matrix_);
-  std::swap(solver_, spare_);
+  field_.gauge_face = gauge_before;
+  gauge_angle_ = gauge_angle_before;
+  recount_dropped_clusters();
 }
 
 void CrossFieldSolver::release_deviating_clusters(const GeometryCache& g) {
@@ -700,7 +712,7 @@ void CrossFieldSolver::release_deviating_clusters(const GeometryCache& g) {
   std::vector<double> sum(field_.clusters, 0.0);
   std::vector<int> count(field_.clusters, 0);
   for (int k = 0; k < nc; ++k) {
-    if (!active(k) || !curvature_class(k)) continue;
+    if (!active(k) || !is_curvature(k)) continue;
     const int cl = cluster_of_[k];
     const double target = c[k] + kQuarter * (relative_q_[k] + cluster_offset_[cl]);
     sum[cl] +=
@@ -716,28 +728,16 @@ void CrossFieldSolver::release_deviating_clusters(const GeometryCache& g) {
     released = true;
   }
   if (!released) return;
-  bool any_left = false;
-  std::vector<char> any_active(field_.clusters, 0);
   for (int k = 0; k < nc; ++k) {
-    if (cluster_active_[cluster_of_[k]]) {
-      any_left = any_left || constraint_active_[k];
-      any_active[cluster_of_[k]] = any_active[cluster_of_[k]] || constraint_active_[k];
-      continue;
-    }
-    if (count[cluster_of_[k]] == 0 || !constraint_active_[k]) continue;  // dropped before
-    const int f = field_.constraints.face[k];
+    const int cl = cluster_of_[k];
+    if (cluster_active_[cl] || count[cl] == 0 || !constraint_active_[k]) continue;
+    const int f = field_.constraints.face[k];  // in a cluster released just now
     matrix_.coeffRef(f, f) -= lambda;
     ++field_.dropped_constraints;
   }
-  if (!any_left && field_.gauge_face < 0) {  // as drop_conflicting_clusters
-    field_.gauge_face = field_.constraints.face[0];
-    gauge_angle_ = field_.theta[field_.gauge_face];
-    matrix_.coeffRef(field_.gauge_face, field_.gauge_face) += lambda;
-  }
-  field_.dropped_clusters = 0;
-  for (int cl = 0; cl < field_.clusters; ++cl) field_.dropped_clusters += !any_active[cl];
-  factorize(spare_, matrix_);
-  std::swap(solver_, spare_);
+  pin_gauge_if_unconstrained();
+  recount_dropped_clusters();
+  factorize_as_current();
   solve(g);
   field_.timings.conflicts_s += seconds_since(t0) - (field_.timings.factorize_s - factorize_before);
 }

@@ -173,6 +173,13 @@ class CrossFieldSolver {
   std::vector<double> constraint_angles(const GeometryCache& geometry) const;
   void factorize(SpdSolver& solver, const Eigen::SparseMatrix<double>& A);  //!< timed, counted
   Eigen::VectorXd back_substitute(const Eigen::VectorXd& b);
+  //! Factorizes matrix_ into spare_ and makes it the current solver (the previous
+  //! factorization stays in spare_).
+  void factorize_as_current();
+  //! When no constraint is in force and no face is pinned: pins one face at its current angle.
+  void pin_gauge_if_unconstrained();
+  //! Marks the clusters with no constraint in force as dropped and counts them.
+  void recount_dropped_clusters();
   //! Relative rotations inside each cluster by propagation over the carrier faces (needs p);
   //! on boundary loops that layout arcs cover, the ones the layout prescribes
   //! (aligned_boundary_turns).
@@ -190,8 +197,9 @@ class CrossFieldSolver {
                                  int tolerated = 0);
   //! Split mode (max_cluster_faces > 0): the conflict passes for the feature and boundary
   //! clusters alone, as a run without curvature constraints does them, before the curvature
-  //! clusters come back into force (two factorizations). Otherwise the curvature clusters next
-  //! to a feature or boundary cluster that contradicts the layout were released in its stead.
+  //! clusters come back into force (one factorization, two when the passes drop some). Otherwise
+  //! the curvature clusters next to a feature or boundary cluster that contradicts the layout were
+  //! released in its stead.
   void drop_structural_conflicts(const TriMesh& mesh, const GeometryCache& geometry, int tolerated);
   //! Releases the curvature clusters that deviate from the layout's own field
   //! (CrossFieldOptions::max_cluster_deviation_deg; one factorization when any is released).
@@ -219,10 +227,8 @@ class CrossFieldSolver {
   std::vector<char> cluster_active_;     //!< per cluster: 0 once dropped as contradictory
   std::vector<char> constraint_active_;  //!< per constraint: 0 once dropped
   bool active(int k) const { return cluster_active_[cluster_of_[k]] && constraint_active_[k]; }
-  //! A curvature constraint (split mode: in a curvature cluster).
-  bool curvature_class(int k) const {
-    return field_.constraints.kind[k] == ConstraintKind::Curvature;
-  }
+  //! A curvature constraint (split mode: its clusters hold no other kind).
+  bool is_curvature(int k) const { return field_.constraints.kind[k] == ConstraintKind::Curvature; }
   std::vector<Vec3> constraint_dir_;  //!< original 3D directions
   double gauge_angle_ = 0;
   int arc_gauge_face_ = -1;     //!< face along the middle of the longest arc
