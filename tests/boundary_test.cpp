@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/field/cross_field.h"
 #include "core/layout/quad_import.h"
 #include "core/layout/routing.h"
 #include "core/layout/validate.h"
@@ -203,6 +204,49 @@ TEST(Boundary, BoundaryNodesSlideOntoTheSquaresCorners) {
     std::printf("[stat] shift %d: E %.6g -> %.3g (sliding), %.6g (not sliding)\n", shift, r.E_init,
                 r.E_final, fixed.E_final);
   }
+}
+
+// Split curvature clusters (CrossFieldOptions::max_cluster_faces) on the coarsened
+// conjugate-direction layout of inspired_mesh, whose boundary constraints contradict the
+// layout: the boundary cluster is settled as in a run without curvature constraints (released
+// there, so released here too; before the structural pass the passes released curvature
+// clusters beside it instead and 180 of its 196 faces stayed in force), and the curvature
+// clusters that deviate from the layout's own field are released (fewer in force than with the
+// deviation test off).
+TEST(Boundary, SplitClustersSettleTheBoundaryAsWithoutCurvature) {
+  const std::string dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes is absent (real-mesh test)";
+  const PolyMesh quads = load_poly_mesh(dir + "/inspired_mesh/inspired_mesh_quads_Conjugate.off");
+  const TriMesh target = load_mesh(dir + "/inspired_mesh/inspired_mesh.obj");
+  QuadImportOptions io;
+  io.coarsen = 16;
+  const QuadImportResult in = import_quads(quads, &target, io);
+  const GeometryCache g = build_geometry(in.mesh);
+  const LayoutTopology topo = build_topology(in.mesh, in.layout);
+  auto summary = [&](bool curvature, int cluster_faces, double deviation_deg) {
+    CrossFieldOptions o;
+    o.constraints.curvature = curvature;
+    o.max_cluster_faces = cluster_faces;
+    o.max_cluster_deviation_deg = deviation_deg;
+    return summarize_constraints(compute_cross_field(in.mesh, g, in.layout, topo, o));
+  };
+  const ConstraintSummary plain = summary(false, 0, 0);
+  const ConstraintSummary split = summary(true, 10, 30);
+  const ConstraintSummary no_deviation_test = summary(true, 10, 0);
+  const int boundary = static_cast<int>(ConstraintKind::Boundary);
+  const int curvature = static_cast<int>(ConstraintKind::Curvature);
+  ASSERT_GT(plain.constrained[boundary], 0);
+  ASSERT_LT(plain.in_force[boundary], plain.constrained[boundary]) << "the case must release";
+  EXPECT_EQ(split.constrained[boundary], plain.constrained[boundary]);
+  EXPECT_EQ(split.in_force[boundary], plain.in_force[boundary]);
+  EXPECT_GT(split.in_force[curvature], 0);
+  EXPECT_LT(split.in_force[curvature], no_deviation_test.in_force[curvature]);
+  std::printf(
+      "[stat] inspired_mesh --coarsen 16, split clusters: boundary %d of %d in force (as without "
+      "curvature: %d), curvature %d of %d (%d without the deviation test)\n",
+      split.in_force[boundary], split.constrained[boundary], plain.in_force[boundary],
+      split.in_force[curvature], split.constrained[curvature],
+      no_deviation_test.in_force[curvature]);
 }
 
 // A boundary-aligned layout on a real model (issue #4 item 7, issue #5): the base complex of
