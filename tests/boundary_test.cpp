@@ -206,6 +206,16 @@ TEST(Boundary, BoundaryNodesSlideOntoTheSquaresCorners) {
   }
 }
 
+// The base complex of libigl's conjugate-field quad mesh of inspired_mesh, coarsened to 15
+// nodes and routed onto the triangle mesh (\p dir: the shared meshes).
+QuadImportResult inspired_coarsened(const std::string& dir) {
+  const PolyMesh quads = load_poly_mesh(dir + "/inspired_mesh/inspired_mesh_quads_Conjugate.off");
+  const TriMesh target = load_mesh(dir + "/inspired_mesh/inspired_mesh.obj");
+  QuadImportOptions io;
+  io.coarsen = 16;
+  return import_quads(quads, &target, io);
+}
+
 // Split curvature clusters (CrossFieldOptions::max_cluster_faces) on the coarsened
 // conjugate-direction layout of inspired_mesh, whose boundary constraints contradict the
 // layout: the boundary cluster is settled as in a run without curvature constraints (released
@@ -216,11 +226,7 @@ TEST(Boundary, BoundaryNodesSlideOntoTheSquaresCorners) {
 TEST(Boundary, SplitClustersSettleTheBoundaryAsWithoutCurvature) {
   const std::string dir = test::shared_meshes_dir();
   if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes is absent (real-mesh test)";
-  const PolyMesh quads = load_poly_mesh(dir + "/inspired_mesh/inspired_mesh_quads_Conjugate.off");
-  const TriMesh target = load_mesh(dir + "/inspired_mesh/inspired_mesh.obj");
-  QuadImportOptions io;
-  io.coarsen = 16;
-  const QuadImportResult in = import_quads(quads, &target, io);
+  const QuadImportResult in = inspired_coarsened(dir);
   const GeometryCache g = build_geometry(in.mesh);
   const LayoutTopology topo = build_topology(in.mesh, in.layout);
   auto summary = [&](bool curvature, int cluster_faces, double deviation_deg) {
@@ -258,11 +264,7 @@ TEST(Boundary, SplitClustersSettleTheBoundaryAsWithoutCurvature) {
 TEST(Boundary, InspiredMeshQuadLayoutEmbedsAfterOptimization) {
   const std::string dir = test::shared_meshes_dir();
   if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes is absent (real-mesh test)";
-  const PolyMesh quads = load_poly_mesh(dir + "/inspired_mesh/inspired_mesh_quads_Conjugate.off");
-  const TriMesh target = load_mesh(dir + "/inspired_mesh/inspired_mesh.obj");
-  QuadImportOptions io;
-  io.coarsen = 16;
-  const QuadImportResult in = import_quads(quads, &target, io);
+  const QuadImportResult in = inspired_coarsened(dir);
   ASSERT_TRUE(validate_layout(in.mesh, in.layout).valid());
   // Boundary-aligned: arcs cover the whole boundary loop.
   auto boundary_covered = [](const TriMesh& mesh, const Layout& layout) {
