@@ -354,6 +354,45 @@ TEST(CrossField, UpdateLayoutEqualsAFreshSolverWithSplitClusters) {
   EXPECT_GT(fresh.field().active_constraints, 0);
 }
 
+TEST(CrossField, SplitReferenceRotationIsChosenOnceAndKeptByUpdateLayout) {
+  // Split mode judges the curvature clusters against the layout's own field, whose global
+  // rotation the ReferenceRotation callback chooses during construction only; update_layout
+  // keeps that rotation (fitted to the last reference) instead of falling back to the arc gauge.
+  const auto in = test::cube_sphere(10, Vec3(2.0, 1.0, 0.75));
+  CrossFieldOptions split;
+  split.max_cluster_faces = 10;
+  const GeometryCache g = build_geometry(in.mesh);
+  const LayoutTopology topo = build_topology(in.mesh, in.layout);
+  int calls = 0;
+  const CrossFieldSolver::ReferenceRotation rotation = [&](const std::vector<int>& period_jump,
+                                                           const std::vector<double>& theta) {
+    ++calls;
+    EXPECT_EQ(static_cast<int>(period_jump.size()), g.n_edges);
+    EXPECT_EQ(static_cast<int>(theta.size()), g.n_faces);
+    return 0.35;  // radians (20°)
+  };
+  CrossFieldSolver rotated(in.mesh, g, in.layout, topo, split, rotation);
+  EXPECT_EQ(calls, 1);
+  EXPECT_GT(rotated.field().timings.reference_rotation_s, 0.0);
+  const CrossFieldSolver gauge(in.mesh, g, in.layout, topo, split);
+  const std::vector<double> theta = rotated.field().theta;
+  ASSERT_GT(max_difference(theta, gauge.field().theta), 1e-3)
+      << "the case must depend on the reference's rotation";
+  rotated.update_layout(in.mesh, g, in.layout, topo);
+  EXPECT_EQ(calls, 1);
+  EXPECT_LT(max_difference(rotated.field().theta, theta), 1e-9);
+  EXPECT_EQ(
+      rotated.field().constraint_active,
+      CrossFieldSolver(in.mesh, g, in.layout, topo, split, rotation).field().constraint_active);
+  // A moved layout keeps the rotation too: its singularities stay at the nodes.
+  const PerturbResult moved = moved_by_two_rings(in);
+  const LayoutTopology topo2 = build_topology(in.mesh, moved.layout);
+  const CrossField& updated = rotated.update_layout(in.mesh, g, moved.layout, topo2);
+  EXPECT_EQ(calls, 2);  // the fresh solver just above
+  const auto idx = field_quarter_indices(g, updated.theta);
+  for (const auto& node : moved.layout.nodes) EXPECT_EQ(idx[node.vertex], 1);
+}
+
 TEST(CrossField, RelaxedWarmStartRoundsLikeTheLargestClusterWarmStart) {
   // The relaxed warm start (no extra factorization) must pick the same cluster rotations as
   // the largest-cluster warm start on models with several constraint clusters.

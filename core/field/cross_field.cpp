@@ -24,12 +24,13 @@ bool interior(const GeometryCache& g, int e) {
 
 CrossFieldSolver::CrossFieldSolver(const TriMesh& mesh, const GeometryCache& g,
                                    const Layout& layout, const LayoutTopology& topology,
-                                   const CrossFieldOptions& options)
+                                   const CrossFieldOptions& options,
+                                   const ReferenceRotation& reference_rotation)
     : options_(options) {
   const auto t_setup = std::chrono::steady_clock::now();
   FieldConstraints constraints = current_constraints(mesh, g, layout);
   field_.timings.curvature_s = seconds_since(t_setup);
-  setup(mesh, g, layout, topology, std::move(constraints));
+  setup(mesh, g, layout, topology, std::move(constraints), 0, reference_rotation);
   field_.timings.setup_s = seconds_since(t_setup);
 }
 
@@ -56,7 +57,7 @@ FieldConstraints CrossFieldSolver::current_constraints(const TriMesh& mesh, cons
 
 void CrossFieldSolver::setup(const TriMesh& mesh, const GeometryCache& g, const Layout& layout,
                              const LayoutTopology& topology, FieldConstraints constraints,
-                             int tolerated) {
+                             int tolerated, const ReferenceRotation& reference_rotation) {
   const CrossFieldOptions& options = options_;
   // Everything but the kept factorizations starts over (update_layout after the constraint set
   // changed calls this on a used solver).
@@ -127,7 +128,7 @@ void CrossFieldSolver::setup(const TriMesh& mesh, const GeometryCache& g, const 
   full_ = solver_;
   full_gauge_face_ = field_.gauge_face;
   drop_structural_conflicts(mesh, g, tolerated);
-  warm_start(g, /*allow_factorization=*/true);
+  warm_start(g, /*allow_factorization=*/true, reference_rotation);
   solve(g);
   release_deviating_clusters(g);
   drop_conflicting_clusters(mesh, g, tolerated);
@@ -393,11 +394,13 @@ void CrossFieldSolver::propagate_clusters(const TriMesh& mesh, const GeometryCac
   field_.clusters = static_cast<int>(cluster_size_.size());
 }
 
-void CrossFieldSolver::warm_start(const GeometryCache& g, bool allow_factorization) {
+void CrossFieldSolver::warm_start(const GeometryCache& g, bool allow_factorization,
+                                  const ReferenceRotation& reference_rotation) {
   reference_theta_.resize(0);
   if (field_.clusters <= 1) return;
   const auto t0 = std::chrono::steady_clock::now();
   const double factorize_before = field_.timings.factorize_s;
+  const double rotation_before = field_.timings.reference_rotation_s;
   const int nc = static_cast<int>(field_.constraints.face.size());
   const double lambda = options_.constraint_weight;
   const std::vector<double> c = constraint_angles(g);
@@ -423,8 +426,9 @@ void CrossFieldSolver::warm_start(const GeometryCache& g, bool allow_factorizati
   if (mode == ClusterWarmStart::Relaxed && !relaxed_fits) mode = ClusterWarmStart::LayoutField;
   // Split curvature clusters are judged against the layout's own field
   // (release_deviating_clusters): it is the warm start then.
-  if (options_.max_cluster_faces > 0 && options_.max_cluster_deviation_deg > 0)
-    mode = ClusterWarmStart::LayoutField;
+  const bool split_reference =
+      options_.max_cluster_faces > 0 && options_.max_cluster_deviation_deg > 0;
+  if (split_reference) mode = ClusterWarmStart::LayoutField;
   if (mode == ClusterWarmStart::LayoutField && arc_gauge_face_ < 0)
     mode = ClusterWarmStart::LargestCluster;  // no arc to pin the reference field along
   if (mode == ClusterWarmStart::LayoutField) {
@@ -456,11 +460,14 @@ void CrossFieldSolver::warm_start(const GeometryCache& g, bool allow_factorizati
     ++field_.timings.solves;
     Eigen::VectorXd reference = reference_.solve(b);
     if (!same_face) reference.array() += arc_gauge_angle_ - reference(arc_gauge_face_);
+    if (split_reference)
+      reference.array() += choose_reference_rotation(reference, reference_rotation);
     std::fill(cluster_offset_.begin(), cluster_offset_.end(), 0);
     round_clusters(c, reference);
     reference_theta_ = std::move(reference);
-    field_.timings.warm_start_s +=
-        seconds_since(t0) - (field_.timings.factorize_s - factorize_before);
+    field_.timings.warm_start_s += seconds_since(t0) -
+                                   (field_.timings.factorize_s - factorize_before) -
+                                   (field_.timings.reference_rotation_s - rotation_before);
     return;
   }
   const bool relaxed = mode == ClusterWarmStart::Relaxed;
@@ -697,6 +704,32 @@ void CrossFieldSolver::drop_structural_conflicts(const TriMesh& mesh, const Geom
   field_.gauge_face = gauge_before;
   gauge_angle_ = gauge_angle_before;
   recount_dropped_clusters();
+}
+
+double CrossFieldSolver::choose_reference_rotation(const Eigen::VectorXd& reference,
+                                                   const ReferenceRotation& reference_rotation) {
+  double phi = 0;
+  if (reference_rotation) {
+    const auto t0 = std::chrono::steady_clock::now();
+    phi = reference_rotation(
+        field_.period_jump,
+        std::vector<double>(reference.data(), reference.data() + reference.size()));
+    field_.timings.reference_rotation_s += seconds_since(t0);
+    if (!std::isfinite(phi)) phi = 0;
+  } else if (rotation_anchor_.size() == reference.size()) {
+    // The rotation that best maps this field onto the anchor up to quarter turns: the mean
+    // direction of 4(anchor − reference) on the circle, divided by 4.
+    double sin_sum = 0, cos_sum = 0;
+    for (Eigen::Index f = 0; f < reference.size(); ++f) {
+      sin_sum += std::sin(4 * (rotation_anchor_(f) - reference(f)));
+      cos_sum += std::cos(4 * (rotation_anchor_(f) - reference(f)));
+    }
+    phi = std::atan2(sin_sum, cos_sum) / 4;
+  } else {
+    return 0;  // the arc gauge
+  }
+  rotation_anchor_ = reference.array() + phi;
+  return phi;
 }
 
 void CrossFieldSolver::release_deviating_clusters(const GeometryCache& g) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -85,11 +86,14 @@ struct CrossFieldTimings {
   double warm_start_s = 0;    //!< warm-start solve and cluster rounding (no factorization)
   double conflicts_s = 0;     //!< conflict checks and re-solves (no factorization)
   double solve_s = 0;         //!< last call of solve(): right-hand side, solves, rounding
-  double setup_s = 0;         //!< whole constructor
-  int factorizations = 0;     //!< numeric factorizations in the setup
-  int solves = 0;             //!< back-substitutions (setup and re-solves)
-  int rounding_passes = 0;    //!< extra solves after re-rounding cluster rotations (last solve)
-  int conflict_passes = 0;    //!< re-solves after dropping contradicting clusters
+  //! split mode: the ReferenceRotation callback (the Pipeline's: one parameterization setup
+  //! and factorization), not part of warm_start_s
+  double reference_rotation_s = 0;
+  double setup_s = 0;       //!< whole constructor
+  int factorizations = 0;   //!< numeric factorizations in the setup
+  int solves = 0;           //!< back-substitutions (setup and re-solves)
+  int rounding_passes = 0;  //!< extra solves after re-rounding cluster rotations (last solve)
+  int conflict_passes = 0;  //!< re-solves after dropping contradicting clusters
 };
 
 struct CrossField {
@@ -114,9 +118,22 @@ struct CrossField {
 //! vertices (new period jumps) only back-substitute with the existing factorization.
 class CrossFieldSolver {
  public:
+  //! Split mode (CrossFieldOptions::max_cluster_faces > 0): chooses the global rotation
+  //! (radians, added to every θ) of the layout's own field, given that field's θ (per face,
+  //! size #F) and the period jumps (per edge, size #E). The Pipeline passes the rotation that
+  //! minimizes the parameterization energy (ParamSolver::optimal_field_rotation), the one a
+  //! field without constraints gets.
+  using ReferenceRotation =
+      std::function<double(const std::vector<int>& period_jump, const std::vector<double>& theta)>;
+
+  //! \p reference_rotation (optional, split mode): see ReferenceRotation; called at most once,
+  //! during construction, and not kept. Without it the layout's own field is pinned along one
+  //! edge of the longest arc, which can lie 45° off the iso-lines (a diagonal of a triangulated
+  //! quad mesh) and then releases the wrong curvature clusters.
   //! \throw TopologyError for layouts whose topology cannot be realized, SolverError.
   CrossFieldSolver(const TriMesh& mesh, const GeometryCache& geometry, const Layout& layout,
-                   const LayoutTopology& topology, const CrossFieldOptions& options = {});
+                   const LayoutTopology& topology, const CrossFieldOptions& options = {},
+                   const ReferenceRotation& reference_rotation = {});
   ~CrossFieldSolver();
   //! A copy shares the factorizations (SpdSolver copies share them until one side factorizes):
   //! copying is O(#F), and a copy re-solved by update_layout or solve does no CHOLMOD analysis
@@ -168,7 +185,8 @@ class CrossFieldSolver {
   //! The constructor after the constraints: period jumps, clusters, matrix, factorization
   //! (analysis reused on the same pattern), warm start, solve and drop passes.
   void setup(const TriMesh& mesh, const GeometryCache& geometry, const Layout& layout,
-             const LayoutTopology& topology, FieldConstraints constraints, int tolerated = 0);
+             const LayoutTopology& topology, FieldConstraints constraints, int tolerated = 0,
+             const ReferenceRotation& reference_rotation = {});
   Eigen::VectorXd rhs(const GeometryCache& geometry, const std::vector<double>& c) const;
   std::vector<double> constraint_angles(const GeometryCache& geometry) const;
   void factorize(SpdSolver& solver, const Eigen::SparseMatrix<double>& A);  //!< timed, counted
@@ -187,7 +205,14 @@ class CrossFieldSolver {
                           const LayoutTopology& topology);
   //! Initial cluster offsets (see ClusterWarmStart); solver_ holds the factorization of matrix_.
   //! Without \p allow_factorization only the relaxed warm start runs (else offsets are kept).
-  void warm_start(const GeometryCache& geometry, bool allow_factorization);
+  void warm_start(const GeometryCache& geometry, bool allow_factorization,
+                  const ReferenceRotation& reference_rotation = {});
+  //! Split mode: the global rotation (radians) to add to the layout's own field \p reference
+  //! (pinned along the arc gauge): \p reference_rotation's when given (construction), else the
+  //! best fit (up to quarter turns) to the last reference whose rotation was chosen so
+  //! (rotation_anchor_: update_layout keeps the rotation as nodes move), else 0.
+  double choose_reference_rotation(const Eigen::VectorXd& reference,
+                                   const ReferenceRotation& reference_rotation);
   void round_clusters(const std::vector<double>& c, const Eigen::VectorXd& theta);
   //! arc_gauge_face_ and arc_gauge_angle_ for \p layout (-1 / 0 without arcs).
   void choose_arc_gauge(const TriMesh& mesh, const GeometryCache& geometry, const Layout& layout);
@@ -244,6 +269,9 @@ class CrossFieldSolver {
   int reference_face_ = -1;
   //! The layout's own field of the last LayoutField warm start (empty otherwise), per face.
   Eigen::VectorXd reference_theta_;
+  //! Split mode: the last layout field whose free rotation ReferenceRotation chose, or which
+  //! continued such a one (empty before): update_layout keeps its rotation.
+  Eigen::VectorXd rotation_anchor_;
   int residual_mismatches_ = 0;  //!< mismatching edges left by the constructor's drop passes
   //! The constructor's matrix and factorization with every constraint in force (before drop
   //! passes), and its gauge face: update_layout starts from them.

@@ -60,8 +60,23 @@ void Pipeline::unshare_solvers() {
 
 const CrossField& Pipeline::compute_field() {
   if (!field_solver_) {
-    field_solver_ =
-        std::make_unique<CrossFieldSolver>(mesh_, geometry_, layout_, topology_, options_.field);
+    // Split clusters are judged against the layout's own field, whose global rotation is
+    // free: it gets the rotation the parameterization would choose for it, as for a field
+    // without constraints (docs/benchmarks.md, session 15). The solver is not kept: its u/v
+    // labels follow the unrotated field (compute_parameterization labels the final one).
+    CrossFieldSolver::ReferenceRotation rotation;
+    if (options_.field.max_cluster_faces > 0)
+      rotation = [this](const std::vector<int>& period_jump, const std::vector<double>& theta) {
+        try {
+          ParamSolver solver(mesh_, geometry_, layout_, topology_, period_jump, theta,
+                             options_.param, nullptr, /*solve_now=*/false);
+          return solver.optimal_field_rotation(mesh_, geometry_, theta);
+        } catch (const QsError&) {
+          return 0.0;  // compute_parameterization() reports it
+        }
+      };
+    field_solver_ = std::make_unique<CrossFieldSolver>(mesh_, geometry_, layout_, topology_,
+                                                       options_.field, rotation);
     return field_solver_->field();
   }
   if (field_layout_stale_) {
