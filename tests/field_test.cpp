@@ -430,9 +430,10 @@ TEST(CrossField, RelaxedWarmStartRoundsLikeTheLargestClusterWarmStart) {
 // layout's singularities, and no cluster exceeds the size limit.
 TEST(CrossField, SplitCurvatureClustersStayInForceWhereTheyFitTheLayout) {
   const auto in = test::cube_sphere(10, Vec3(2.0, 1.0, 0.75));
-  CrossFieldOptions split;
+  CrossFieldOptions split, whole_clusters;
   split.max_cluster_faces = 10;
-  const Solved whole = solve_field(in, 0, {}), parts = solve_field(in, 0, split);
+  whole_clusters.max_cluster_faces = 0;
+  const Solved whole = solve_field(in, 0, whole_clusters), parts = solve_field(in, 0, split);
   const int curvature = whole.field.constraints.count(ConstraintKind::Curvature);
   ASSERT_GT(curvature, 100);
   ASSERT_EQ(parts.field.constraints.count(ConstraintKind::Curvature), curvature);

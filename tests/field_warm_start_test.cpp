@@ -28,6 +28,7 @@ Outcome solve(const TriMesh& mesh, const Layout& layout, ClusterWarmStart mode) 
   const LayoutTopology topo = build_topology(mesh, layout);
   CrossFieldOptions fo;
   fo.warm_start = mode;
+  fo.max_cluster_faces = 0;  // whole clusters (split clusters always start from the layout field)
   const CrossField field = compute_cross_field(mesh, g, layout, topo, fo);
   ParamSolver solver(mesh, g, layout, topo, field.period_jump, field.theta);
   const Parameterization& p = solver.result();

@@ -70,8 +70,11 @@ bool same_constraint_faces(const FieldConstraints& a, const FieldConstraints& b)
 // is the fresh Pipeline's at the relocated geometry (same constraint faces and directions, same
 // singularities, θ equal modulo quarter turns to solver tolerance, same E and fold-overs),
 // whether the relocation changed the constraint faces or only their directions.
+// (Whole constraint clusters: with split ones the continued field keeps the layout field's
+// rotation the first construction chose, CrossFieldSolver::update_layout.)
 void check_continued_matches_fresh(const Example& ex) {
-  const PipelineOptions options;
+  PipelineOptions options;
+  options.field.max_cluster_faces = 0;
   Pipeline first(ex.mesh, ex.layout, options);
   first.compute_field();
   first.compute_parameterization();

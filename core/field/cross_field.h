@@ -63,12 +63,12 @@ struct CrossFieldOptions {
   //! With whole regions one rotation must suit a region that crosses the layout's
   //! singularities, so the conflict passes release whole regions: cage layouts kept 0.2–13 %
   //! of their curvature constraints and the aligned run barely differed from --no-align. Split
-  //! clusters are released only where they contradict the layout. At 10, on layouts that
-  //! follow the curvature (the QuadWild joint) and on most cage layouts the aligned E° falls
-  //! below --no-align's (fold-overs vary); on layouts that do not follow the curvature
-  //! (inspired_mesh's conjugate-direction layout) the kept clusters twist the field against
-  //! the arcs (E 2.7× higher, not embeddable after node optimization), hence opt-in.
-  //! docs/benchmarks.md, session 14. (`--max-cluster-faces`)
+  //! clusters are released only where they contradict the layout. At 10 the aligned E° falls
+  //! below --no-align's on 14 of 16 test layouts (cage layouts, QuadWild and own quads, the
+  //! conjugate-direction layout of inspired_mesh; a few % above it on two coarse animal cages),
+  //! and the rocker-arm cage layout embeds only so. Opt-in for its cost: more field
+  //! factorizations in every step (the 70K bunny's 25-step optimization takes about twice as
+  //! long). docs/benchmarks.md, sessions 14 and 15. (`--max-cluster-faces`)
   int max_cluster_faces = 0;
   //! Split mode: a curvature cluster whose targets deviate from the layout's own field (the
   //! smoothest field with the layout's singularities, the warm start in split mode) by more
@@ -158,7 +158,10 @@ class CrossFieldSolver {
   //! mismatch than the constructor's passes left). Otherwise it sets up again as the
   //! constructor (one numeric factorization with the kept analysis, plus drop passes with the
   //! same tolerance). Either way the field is a fresh construction's at this geometry up to
-  //! solver round-off, unless a drop pass that the tolerance skips would have helped.
+  //! solver round-off, unless a drop pass that the tolerance skips would have helped, or (split
+  //! mode) the construction chose the layout field's rotation (ReferenceRotation): the update
+  //! keeps that rotation (fitted to the last reference) where a fresh construction would
+  //! choose again, so the descent's field does not jump between steps.
   //! \throw TopologyError as the constructor, InvalidInputError when the mesh size changed.
   const CrossField& update_layout(const TriMesh& mesh, const GeometryCache& geometry,
                                   const Layout& layout, const LayoutTopology& topology);
