@@ -67,7 +67,7 @@ int main(int argc, char** argv) {
     std::fprintf(
         stderr,
         "usage: %s MESH LAYOUT [STEPS=10] [REPEATS=3] [descent] [fresh] [parallel] [steps] "
-        "[default-malloc]\n",
+        "[default-malloc] [split=N]\n",
         argv[0]);
     return 2;
   }
@@ -86,7 +86,9 @@ int main(int argc, char** argv) {
     // "steps": print every step.
     bool descent_only = false, fresh_trials = false, verbose = false, parallel = false;
     bool keep_memory = true;
+    int max_cluster_faces = -1;  // split=N: CrossFieldOptions::max_cluster_faces
     for (int k = 5; k < argc; ++k) {
+      if (std::string(argv[k]).rfind("split=", 0) == 0) max_cluster_faces = std::atoi(argv[k] + 6);
       keep_memory &= std::string(argv[k]) != "default-malloc";
       descent_only |= std::string(argv[k]) == "descent";
       fresh_trials |= std::string(argv[k]) == "fresh";
@@ -96,7 +98,8 @@ int main(int argc, char** argv) {
     // As quadsketch-cli and the GUI do (core/base/allocator.h); "default-malloc": glibc's
     // defaults (every solve page-faults its factorization in again).
     if (keep_memory) qs::keep_freed_memory();
-    const qs::PipelineOptions options;
+    qs::PipelineOptions options;
+    if (max_cluster_faces >= 0) options.field.max_cluster_faces = max_cluster_faces;
     std::vector<double> fresh, resolve, step, total, ratio;
     for (int rep = 0; rep < repeats; ++rep) {
       double t0 = cpu_now();

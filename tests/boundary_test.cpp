@@ -255,6 +255,63 @@ TEST(Boundary, SplitClustersSettleTheBoundaryAsWithoutCurvature) {
       no_deviation_test.in_force[curvature]);
 }
 
+// update_layout in split mode starts the structural pass from the feature and boundary
+// constraints the last pass dropped (on the 70K bunny 1730 of 1750 feature faces are dropped
+// at every descent step, and the passes cost four to six factorizations each time). On the
+// conjugate layout of inspired_mesh, whose boundary constraints are released: an update with
+// the same layout drops the same boundary faces as the construction with fewer factorizations
+// (no structural pass, no full factorization), and an update with moved nodes still settles the
+// boundary as a run without curvature constraints does.
+TEST(Boundary, SplitClusterUpdatesStartFromTheLastStructuralDrops) {
+  const std::string dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes is absent (real-mesh test)";
+  const QuadImportResult in = inspired_coarsened(dir);
+  const GeometryCache g = build_geometry(in.mesh);
+  const LayoutTopology topo = build_topology(in.mesh, in.layout);
+  CrossFieldOptions split;
+  split.max_cluster_faces = 10;
+  CrossFieldSolver solver(in.mesh, g, in.layout, topo, split);
+  const CrossField built = solver.field();
+  auto boundary_in_force = [](const CrossField& f) {
+    std::vector<char> in_force;
+    for (size_t k = 0; k < f.constraints.face.size(); ++k)
+      if (f.constraints.kind[k] == ConstraintKind::Boundary)
+        in_force.push_back(f.constraint_active[k]);
+    return in_force;
+  };
+  const std::vector<char> boundary = boundary_in_force(built);
+  ASSERT_GT(std::count(boundary.begin(), boundary.end(), 0), 0) << "the case must release";
+  const CrossField& again = solver.update_layout(in.mesh, g, in.layout, topo);
+  const int built_factorizations = built.timings.factorizations;
+  const int update_factorizations = again.timings.factorizations - built_factorizations;
+  EXPECT_EQ(boundary_in_force(again), boundary);
+  EXPECT_EQ(again.constraint_active, built.constraint_active);
+  ASSERT_EQ(again.theta.size(), built.theta.size());
+  for (size_t f = 0; f < built.theta.size(); ++f)
+    ASSERT_NEAR(again.theta[f], built.theta[f], 1e-9) << "face " << f;
+  const int update_passes = again.timings.conflict_passes - built.timings.conflict_passes;
+  EXPECT_LT(update_passes, built.timings.conflict_passes);
+  EXPECT_LT(update_factorizations, built_factorizations);
+  std::printf(
+      "[stat] inspired_mesh --coarsen 16, split clusters: %d factorizations and %d drop passes to "
+      "build the field, %d and %d to update it with the same layout\n",
+      built_factorizations, built.timings.conflict_passes, update_factorizations, update_passes);
+
+  CrossFieldOptions plain;
+  plain.constraints.curvature = false;
+  for (int seed = 1; seed <= 2; ++seed) {
+    const Layout moved = test::displace_nodes(in.mesh, in.layout, 2, seed);
+    const LayoutTopology moved_topo = build_topology(in.mesh, moved);
+    const CrossField& updated = solver.update_layout(in.mesh, g, moved, moved_topo);
+    const ConstraintSummary s = summarize_constraints(updated);
+    const ConstraintSummary p =
+        summarize_constraints(compute_cross_field(in.mesh, g, moved, moved_topo, plain));
+    const int b = static_cast<int>(ConstraintKind::Boundary);
+    EXPECT_EQ(s.in_force[b], p.in_force[b]) << "seed " << seed;
+    EXPECT_GT(s.in_force[static_cast<int>(ConstraintKind::Curvature)], 0) << "seed " << seed;
+  }
+}
+
 TEST(Boundary, SplitClustersFollowTheParameterizationsRotationOnTheConjugateLayout) {
   // The layout's arcs run along conjugate directions, about 45° from the principal ones. Split
   // clusters are judged against the layout's own field turned as the parameterization turns a

@@ -120,13 +120,19 @@ void CrossFieldSolver::setup(const TriMesh& mesh, const GeometryCache& g, const 
   matrix_.setFromTriplets(triplets.begin(), triplets.end());
   field_.timings.assemble_s = seconds_since(t0);
 
-  // The only factorization needed when no cluster contradicts the layout.
-  factorize(solver_, matrix_);
   // Kept for update_layout, which starts again from every constraint (shared with solver_ until
   // a drop pass factorizes: SpdSolver copies are copy-on-write).
   full_matrix_ = matrix_;
-  full_ = solver_;
   full_gauge_face_ = field_.gauge_face;
+  full_factorized_ = false;
+  if (!structural_pass_applies()) {
+    // The only factorization needed when no cluster contradicts the layout. (The structural
+    // pass factorizes without the curvature constraints first, and this one only if it drops
+    // nothing.)
+    factorize(solver_, matrix_);
+    full_ = solver_;
+    full_factorized_ = true;
+  }
   drop_structural_conflicts(mesh, g, tolerated);
   warm_start(g, /*allow_factorization=*/true, reference_rotation);
   solve(g);
@@ -649,30 +655,33 @@ void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const Geom
   field_.timings.conflicts_s += seconds_since(t0) - (field_.timings.factorize_s - factorize_before);
 }
 
-void CrossFieldSolver::drop_structural_conflicts(const TriMesh& mesh, const GeometryCache& g,
-                                                 int tolerated) {
+bool CrossFieldSolver::structural_pass_applies() const {
   const int nc = static_cast<int>(field_.constraints.face.size());
-  if (options_.max_cluster_faces <= 0 || nc == 0 || options_.max_conflict_passes <= 0) return;
-  // Curvature clusters in force (split mode: a cluster has constraints of one class only).
-  std::vector<char> curvature(field_.clusters, 0);
-  bool any_structural = false;
+  if (options_.max_cluster_faces <= 0 || nc == 0 || options_.max_conflict_passes <= 0) return false;
+  bool any_structural = false, any_curvature = false;
   for (int k = 0; k < nc; ++k) {
     if (!active(k)) continue;
-    if (is_curvature(k))
-      curvature[cluster_of_[k]] = 1;
-    else
-      any_structural = true;
+    (is_curvature(k) ? any_curvature : any_structural) = true;
   }
-  if (!any_structural || std::find(curvature.begin(), curvature.end(), 1) == curvature.end())
-    return;
+  return any_structural && any_curvature;
+}
+
+void CrossFieldSolver::drop_structural_conflicts(const TriMesh& mesh, const GeometryCache& g,
+                                                 int tolerated) {
+  if (!structural_pass_applies()) return;
+  const int nc = static_cast<int>(field_.constraints.face.size());
+  // Curvature clusters in force (split mode: a cluster has constraints of one class only).
+  std::vector<char> curvature(field_.clusters, 0);
+  for (int k = 0; k < nc; ++k)
+    if (active(k) && is_curvature(k)) curvature[cluster_of_[k]] = 1;
   const double lambda = options_.constraint_weight;
   const int gauge_before = field_.gauge_face;
   const double gauge_angle_before = gauge_angle_;
   const int dropped_before = field_.dropped_constraints;
-  // The state to come back to when no feature or boundary constraint is dropped.
+  // The state to come back to when no feature or boundary constraint is dropped: every
+  // constraint in force (setup and update_layout call this pass with the full matrix).
   const Eigen::SparseMatrix<double> matrix_before = matrix_;
-  const SpdSolver solver_before = solver_;  // shares the factorization (copy-on-write)
-  std::vector<int> lifted;                  // curvature constraints set aside
+  std::vector<int> lifted;  // curvature constraints set aside
   for (int k = 0; k < nc; ++k) {
     if (!active(k) || !curvature[cluster_of_[k]]) continue;
     const int f = field_.constraints.face[k];
@@ -681,16 +690,50 @@ void CrossFieldSolver::drop_structural_conflicts(const TriMesh& mesh, const Geom
   }
   for (int cl = 0; cl < field_.clusters; ++cl)
     if (curvature[cl]) cluster_active_[cl] = 0;
+  // The feature and boundary clusters with a face the last pass dropped are dropped again
+  // before the first factorization (whole clusters, or those faces in ConflictDrop::Faces).
+  const bool by_faces = options_.conflict_drop == ConflictDrop::Faces;
+  if (structural_dropped_.size() == static_cast<size_t>(g.n_faces)) {
+    std::vector<char> again(field_.clusters, 0);
+    for (int k = 0; k < nc; ++k) {
+      if (!active(k) || !structural_dropped_[field_.constraints.face[k]]) continue;
+      if (by_faces) {
+        constraint_active_[k] = 0;
+        const int f = field_.constraints.face[k];
+        matrix_.coeffRef(f, f) -= lambda;
+        ++field_.dropped_constraints;
+      } else {
+        again[cluster_of_[k]] = 1;
+      }
+    }
+    for (int k = 0; k < nc; ++k) {
+      if (!again[cluster_of_[k]] || !constraint_active_[k]) continue;
+      const int f = field_.constraints.face[k];
+      matrix_.coeffRef(f, f) -= lambda;
+      ++field_.dropped_constraints;
+    }
+    for (int cl = 0; cl < field_.clusters; ++cl)
+      if (again[cl]) cluster_active_[cl] = 0;
+    pin_gauge_if_unconstrained();
+  }
   factorize_as_current();
   solve(g);
   drop_conflicting_clusters(mesh, g, tolerated);
+  structural_dropped_.assign(g.n_faces, 0);
+  for (int k = 0; k < nc; ++k)
+    if (!is_curvature(k) && !active(k)) structural_dropped_[field_.constraints.face[k]] = 1;
   // The curvature clusters back in force.
   for (int cl = 0; cl < field_.clusters; ++cl)
     if (curvature[cl]) cluster_active_[cl] = 1;
   if (field_.dropped_constraints == dropped_before) {
-    // Nothing dropped: the matrix and factorization from before (no second factorization).
+    // Nothing dropped: the matrix and factorization with every constraint in force (made now
+    // if setup left it for this case).
     matrix_ = matrix_before;
-    solver_ = solver_before;
+    if (!full_factorized_) {
+      factorize(full_, full_matrix_);
+      full_factorized_ = true;
+    }
+    solver_ = full_;
   } else {
     for (int k : lifted) {
       const int f = field_.constraints.face[k];
@@ -901,7 +944,9 @@ const CrossField& CrossFieldSolver::update_layout(const TriMesh& mesh, const Geo
   const int nc = static_cast<int>(field_.constraints.face.size());
   if (nc > 0 && field_.dropped_constraints > 0) {
     matrix_ = full_matrix_;
-    solver_ = full_;
+    // Not factorized: the structural pass applies (same constraint kinds, all in force) and
+    // factorizes before any solve.
+    if (full_factorized_) solver_ = full_;
     cluster_active_.assign(field_.clusters, 1);
     constraint_active_.assign(nc, 1);
     field_.dropped_constraints = 0;
