@@ -125,18 +125,14 @@ void CrossFieldSolver::setup(const TriMesh& mesh, const GeometryCache& g, const 
   full_matrix_ = matrix_;
   full_gauge_face_ = field_.gauge_face;
   full_factorized_ = false;
-  if (!structural_pass_applies()) {
-    // The only factorization needed when no cluster contradicts the layout. (The structural
-    // pass factorizes without the curvature constraints first, and this one only if it drops
-    // nothing.)
-    factorize(solver_, matrix_);
-    full_ = solver_;
-    full_factorized_ = true;
-  }
+  current_ = false;
+  // The only factorization needed when no cluster contradicts the layout, made by the first
+  // solve: in split mode the structural pass and the deviation release change the matrix
+  // before it (one factorization for both).
   drop_structural_conflicts(mesh, g, tolerated);
   warm_start(g, /*allow_factorization=*/true, reference_rotation);
-  solve(g);
   release_deviating_clusters(g);
+  solve(g);
   drop_conflicting_clusters(mesh, g, tolerated);
   residual_mismatches_ = count_mismatches(g);
   field_.active_constraints = nc - field_.dropped_constraints;
@@ -180,16 +176,27 @@ void CrossFieldSolver::factorize(SpdSolver& solver, const Eigen::SparseMatrix<do
 void CrossFieldSolver::factorize_as_current() {
   factorize(spare_, matrix_);
   std::swap(solver_, spare_);
+  current_ = true;
 }
 
-void CrossFieldSolver::pin_gauge_if_unconstrained() {
+void CrossFieldSolver::make_current() {
+  if (current_) return;
+  factorize_as_current();
+  if (!full_factorized_ && field_.dropped_constraints == 0 &&
+      field_.gauge_face == full_gauge_face_) {
+    full_ = solver_;  // shared (copy-on-write): update_layout starts from it
+    full_factorized_ = true;
+  }
+}
+
+void CrossFieldSolver::pin_gauge_if_unconstrained(const Eigen::VectorXd* theta) {
   if (field_.gauge_face >= 0) return;
   for (int k = 0; k < static_cast<int>(field_.constraints.face.size()); ++k)
     if (active(k)) return;
   // Nothing left to fix the global rotation on a closed surface: pin one face (it is re-chosen
   // to minimize the energy by the parameterization stage).
   field_.gauge_face = field_.constraints.face[0];
-  gauge_angle_ = field_.theta[field_.gauge_face];
+  gauge_angle_ = theta ? (*theta)(field_.gauge_face) : field_.theta[field_.gauge_face];
   matrix_.coeffRef(field_.gauge_face, field_.gauge_face) += options_.constraint_weight;
 }
 
@@ -486,6 +493,7 @@ void CrossFieldSolver::warm_start(const GeometryCache& g, bool allow_factorizati
     // and S = λ(π/2)·(cluster indicators). θ(o) = θ₀ + Y o with Y = L⁻¹S, and the reduced
     // system is (λ(π/2)²·diag(n) − SᵀY) o = Sᵀθ₀ − λ(π/2)·Σ_cluster t_f.
     const int m = static_cast<int>(others.size());
+    make_current();
     const Eigen::VectorXd theta0 = back_substitute(rhs(g, c));
     Eigen::MatrixXd S = Eigen::MatrixXd::Zero(g.n_faces, m);
     Eigen::VectorXd r = Eigen::VectorXd::Zero(m);
@@ -725,15 +733,16 @@ void CrossFieldSolver::drop_structural_conflicts(const TriMesh& mesh, const Geom
   // The curvature clusters back in force.
   for (int cl = 0; cl < field_.clusters; ++cl)
     if (curvature[cl]) cluster_active_[cl] = 1;
+  // The next solve factorizes the matrix with the curvature constraints back (after the
+  // deviation release has changed it too).
   if (field_.dropped_constraints == dropped_before) {
-    // Nothing dropped: the matrix and factorization with every constraint in force (made now
-    // if setup left it for this case).
+    // Nothing dropped: every constraint in force, as before the pass.
     matrix_ = matrix_before;
-    if (!full_factorized_) {
-      factorize(full_, full_matrix_);
-      full_factorized_ = true;
+    current_ = false;
+    if (full_factorized_) {
+      solver_ = full_;
+      current_ = true;
     }
-    solver_ = full_;
   } else {
     for (int k : lifted) {
       const int f = field_.constraints.face[k];
@@ -742,7 +751,7 @@ void CrossFieldSolver::drop_structural_conflicts(const TriMesh& mesh, const Geom
     // A gauge the passes pinned when nothing was left in force is not needed any more.
     if (field_.gauge_face != gauge_before && field_.gauge_face >= 0)
       matrix_.coeffRef(field_.gauge_face, field_.gauge_face) -= lambda;
-    factorize_as_current();
+    current_ = false;
   }
   field_.gauge_face = gauge_before;
   gauge_angle_ = gauge_angle_before;
@@ -811,10 +820,9 @@ void CrossFieldSolver::release_deviating_clusters(const GeometryCache& g) {
     matrix_.coeffRef(f, f) -= lambda;
     ++field_.dropped_constraints;
   }
-  pin_gauge_if_unconstrained();
+  pin_gauge_if_unconstrained(&reference_theta_);
   recount_dropped_clusters();
-  factorize_as_current();
-  solve(g);
+  current_ = false;  // the caller's solve factorizes
   field_.timings.conflicts_s += seconds_since(t0) - (field_.timings.factorize_s - factorize_before);
 }
 
@@ -882,10 +890,11 @@ void CrossFieldSolver::round_clusters(const std::vector<double>& c, const Eigen:
 }
 
 const CrossField& CrossFieldSolver::solve(const GeometryCache& g) {
-  const auto t0 = std::chrono::steady_clock::now();
   if (g.n_faces != matrix_.rows())
     throw InvalidInputError("cross field: the geometry has " + std::to_string(g.n_faces) +
                             " faces, the solver was built for " + std::to_string(matrix_.rows()));
+  make_current();  // timed as a factorization
+  const auto t0 = std::chrono::steady_clock::now();
   const int nc = static_cast<int>(field_.constraints.face.size());
   const std::vector<double> c = constraint_angles(g);
   Eigen::VectorXd theta = back_substitute(rhs(g, c));
@@ -944,8 +953,8 @@ const CrossField& CrossFieldSolver::update_layout(const TriMesh& mesh, const Geo
   const int nc = static_cast<int>(field_.constraints.face.size());
   if (nc > 0 && field_.dropped_constraints > 0) {
     matrix_ = full_matrix_;
-    // Not factorized: the structural pass applies (same constraint kinds, all in force) and
-    // factorizes before any solve.
+    // Not factorized yet: the next solve factorizes.
+    current_ = full_factorized_;
     if (full_factorized_) solver_ = full_;
     cluster_active_.assign(field_.clusters, 1);
     constraint_active_.assign(nc, 1);
@@ -955,8 +964,8 @@ const CrossField& CrossFieldSolver::update_layout(const TriMesh& mesh, const Geo
   }
   drop_structural_conflicts(mesh, g, residual_mismatches_);
   warm_start(g, /*allow_factorization=*/false);
-  solve(g);
   release_deviating_clusters(g);
+  solve(g);
   // Clusters that contradict the new layout (steps across edges that disagree with the new
   // period jumps) are dropped as in the constructor; this factorizes only when there are any.
   // As many mismatches as the constructor's passes left (the smoothest field itself turns by

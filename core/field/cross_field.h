@@ -197,8 +197,12 @@ class CrossFieldSolver {
   //! Factorizes matrix_ into spare_ and makes it the current solver (the previous
   //! factorization stays in spare_).
   void factorize_as_current();
-  //! When no constraint is in force and no face is pinned: pins one face at its current angle.
-  void pin_gauge_if_unconstrained();
+  //! factorize_as_current when solver_ does not factorize matrix_ (current_ false); keeps the
+  //! factorization as full_ when every constraint is in force.
+  void make_current();
+  //! When no constraint is in force and no face is pinned: pins one face at its angle in
+  //! \p theta (default: the last solved field).
+  void pin_gauge_if_unconstrained(const Eigen::VectorXd* theta = nullptr);
   //! Marks the clusters with no constraint in force as dropped and counts them.
   void recount_dropped_clusters();
   //! Relative rotations inside each cluster by propagation over the carrier faces (needs p);
@@ -225,7 +229,8 @@ class CrossFieldSolver {
                                  int tolerated = 0);
   //! Split mode (max_cluster_faces > 0): the conflict passes for the feature and boundary
   //! clusters alone, as a run without curvature constraints does them, before the curvature
-  //! clusters come back into force (one factorization, two when the passes drop some). Otherwise
+  //! clusters come back into force (one factorization per pass; the next solve factorizes the
+  //! matrix with the curvature constraints back, with no pass the full one). Otherwise
   //! the curvature clusters next to a feature or boundary cluster that contradicts the layout were
   //! released in its stead.
   //! update_layout starts the passes from the feature and boundary constraints the last pass
@@ -236,7 +241,8 @@ class CrossFieldSolver {
   //! Whether drop_structural_conflicts runs its passes with every constraint in force.
   bool structural_pass_applies() const;
   //! Releases the curvature clusters that deviate from the layout's own field
-  //! (CrossFieldOptions::max_cluster_deviation_deg; one factorization when any is released).
+  //! (CrossFieldOptions::max_cluster_deviation_deg). Only the matrix changes: the next solve
+  //! factorizes it, once for the structural pass's drops and these releases together.
   void release_deviating_clusters(const GeometryCache& geometry);
   //! Interior edges whose principal matching differs from the period jump.
   int count_mismatches(const GeometryCache& geometry) const;
@@ -269,6 +275,9 @@ class CrossFieldSolver {
   double arc_gauge_angle_ = 0;  //!< that arc edge's angle in the face
   Eigen::SparseMatrix<double> matrix_;
   SpdSolver solver_{"cross field"};
+  //! Whether solver_ factorizes matrix_ (solve() factorizes first when not: the structural
+  //! pass and the deviation release only change the matrix).
+  bool current_ = false;
   //! Second factorization of the same pattern (trial drops, largest-cluster warm start), so a
   //! rejected trial never needs a re-factorization; symbolic analysis reused between trials.
   SpdSolver spare_{"cross field"};
