@@ -207,7 +207,10 @@ TEST(Cli, MaxClusterFacesKeepsMoreCurvatureConstraintsInForce) {
   save_layout(in.layout, dir + "/layout.json", &in.mesh);
   const std::string files = " --mesh " + dir + "/mesh.obj --layout " + dir + "/layout.json";
   std::string out;
-  ASSERT_EQ(test::run_command(cli("field" + files + " --out " + dir + "/whole"), &out), 0) << out;
+  ASSERT_EQ(test::run_command(
+                cli("field" + files + " --max-cluster-faces 0 --out " + dir + "/whole"), &out),
+            0)
+      << out;
   ASSERT_EQ(test::run_command(
                 cli("field" + files + " --max-cluster-faces 10 --out " + dir + "/split"), &out),
             0)

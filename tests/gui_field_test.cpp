@@ -70,7 +70,9 @@ TEST(GuiField, SnapshotMarksReleasedConstraintsAndWarns) {
   // (tests/field_test.cpp): the editor shows them as released and warns in the Metrics panel.
   const auto in = test::cube_sphere(10, Vec3(2.0, 1.0, 0.75));
   const Example ex{std::make_shared<TriMesh>(in.mesh), in.layout};
-  const auto s = solve_once(ex, WorkerOptions{});
+  WorkerOptions whole;  // one cluster per connected region (the default splits them)
+  whole.max_cluster_faces = 0;
+  const auto s = solve_once(ex, whole);
   ASSERT_EQ(s->status, WorkerStatus::Finished) << s->message;
   ASSERT_TRUE(s->field);
   const FieldView& field = *s->field;

@@ -5,6 +5,8 @@
 #include <optional>
 #include <string>
 
+#include "core/field/cross_field.h"
+
 namespace qs::cli {
 
 struct CommonOptions {
@@ -18,7 +20,7 @@ struct ValidateOptions {
 struct FieldOptions {
   std::string mesh, layout, out;
   double sharp_angle_deg = 35.0;
-  int max_cluster_faces = 0;  //!< CrossFieldOptions::max_cluster_faces
+  int max_cluster_faces = CrossFieldOptions{}.max_cluster_faces;
 };
 
 struct OptimizeOptions {
@@ -37,8 +39,8 @@ struct OptimizeOptions {
   //! Curl-reducing sizing field (ParamOptions::sizing); unset: the library default.
   std::optional<bool> sizing;
   double sharp_angle_deg = 35.0;
-  int max_cluster_faces = 0;  //!< CrossFieldOptions::max_cluster_faces
-  int threads = 1;            //!< math-library threads (core/base/solver_threads.h)
+  int max_cluster_faces = CrossFieldOptions{}.max_cluster_faces;
+  int threads = 1;  //!< math-library threads (core/base/solver_threads.h)
 };
 
 struct ImportQuadsOptions {

@@ -392,9 +392,9 @@ void App::draw_pipeline_options() {
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip(
         "Split the curvature constraints into clusters of at most this many faces, released one "
-        "by one where they contradict the layout (0: whole connected regions). 10 keeps far more "
-        "in force and lowers the angle error on most layouts; each step of Run takes about twice "
-        "as long (--max-cluster-faces)");
+        "by one where they contradict the layout (0: whole connected regions, which a layout "
+        "that crosses them mostly releases). 10 (the default) keeps far more in force and lowers "
+        "the angle error on most layouts (--max-cluster-faces)");
   if (!o.align) ImGui::EndDisabled();
   float anisotropy = float(o.anisotropy);
   if (ImGui::SliderFloat("Anisotropy", &anisotropy, 1.0f, 100.0f, "%.1f",

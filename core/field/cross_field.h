@@ -66,10 +66,12 @@ struct CrossFieldOptions {
   //! clusters are released only where they contradict the layout. At 10 the aligned E° falls
   //! below --no-align's on 14 of 16 test layouts (cage layouts, QuadWild and own quads, the
   //! conjugate-direction layout of inspired_mesh; a few % above it on two coarse animal cages),
-  //! and the rocker-arm cage layout embeds only so. Opt-in for its cost: more field
-  //! factorizations in every step (the 70K bunny's 25-step optimization takes about twice as
-  //! long). docs/benchmarks.md, sessions 14 and 15. (`--max-cluster-faces`)
-  int max_cluster_faces = 0;
+  //! and the rocker-arm cage layout embeds only so. Default since session 16, when the
+  //! descent's field updates got cheap enough (update_layout starts the structural pass from its
+  //! last drops; the 70K bunny's 25 descent steps: 25 s against 23 s with whole regions, and a
+  //! final E 29 % lower). 0: whole regions. docs/benchmarks.md, sessions 14–16.
+  //! (`--max-cluster-faces`)
+  int max_cluster_faces = 10;
   //! Split mode: a curvature cluster whose targets deviate from the layout's own field (the
   //! smoothest field with the layout's singularities, the warm start in split mode) by more
   //! than this mean angle (degrees, up to quarter turns; 45 at most) is released before the

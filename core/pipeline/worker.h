@@ -22,6 +22,7 @@
 #include <variant>
 
 #include "core/base/progress.h"
+#include "core/field/cross_field.h"
 #include "core/layout/layout.h"
 #include "core/mesh/mesh.h"
 #include "core/pipeline/snapshot.h"
@@ -41,7 +42,7 @@ struct WorkerOptions {
   bool align = true;              //!< false: ignore curvature directions (--no-align)
   double sharp_angle_deg = 35.0;  //!< sharp feature dihedral angle (--sharp-angle)
   //! Split curvature clusters of at most this many faces (--max-cluster-faces; 0: off)
-  int max_cluster_faces = 0;
+  int max_cluster_faces = CrossFieldOptions{}.max_cluster_faces;
   double anisotropy = 10.0;       //!< anisotropic norm factor of the parameterization energy
   double alpha = 0.75;            //!< initial damping α of node-optimization steps
   int descent_steps = 25;         //!< descent steps before the first hop sweep (--steps)
