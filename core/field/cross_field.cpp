@@ -686,9 +686,6 @@ void CrossFieldSolver::drop_structural_conflicts(const TriMesh& mesh, const Geom
   const int gauge_before = field_.gauge_face;
   const double gauge_angle_before = gauge_angle_;
   const int dropped_before = field_.dropped_constraints;
-  // The state to come back to when no feature or boundary constraint is dropped: every
-  // constraint in force (setup and update_layout call this pass with the full matrix).
-  const Eigen::SparseMatrix<double> matrix_before = matrix_;
   std::vector<int> lifted;  // curvature constraints set aside
   for (int k = 0; k < nc; ++k) {
     if (!active(k) || !curvature[cluster_of_[k]]) continue;
@@ -736,8 +733,9 @@ void CrossFieldSolver::drop_structural_conflicts(const TriMesh& mesh, const Geom
   // The next solve factorizes the matrix with the curvature constraints back (after the
   // deviation release has changed it too).
   if (field_.dropped_constraints == dropped_before) {
-    // Nothing dropped: every constraint in force, as before the pass.
-    matrix_ = matrix_before;
+    // Nothing dropped: every constraint in force, as before the pass (setup and update_layout
+    // call it with the full matrix).
+    matrix_ = full_matrix_;
     current_ = false;
     if (full_factorized_) {
       solver_ = full_;
