@@ -313,6 +313,62 @@ TEST(Cli, OptimizeMovesTheSketchedNodesAndRemovesFoldovers) {
   }
 }
 
+// --no-node-opt --orientation: the fixed nodes' parameterization with strict orientation
+// constraints. The bundled sketch folds with fixed nodes (see above); with --orientation the
+// same nodes give a fold-free, structurally equivalent embedding, and the report says what the
+// fold-over removal did. The flag is refused where it does not apply.
+TEST(Cli, OrientationRemovesFoldoversWithoutNodeOptimization) {
+  const std::string plain = test::temp_dir("cli_plain"), oriented = test::temp_dir("cli_oriented");
+  const std::string files = " --mesh " + kMesh + " --layout " + kLayout;
+  std::string out;
+  ASSERT_EQ(
+      test::run_command(cli("optimize --no-node-opt --quiet" + files + " --out " + plain), &out), 0)
+      << out;
+  ASSERT_EQ(test::run_command(
+                cli("optimize --no-node-opt --orientation" + files + " --out " + oriented), &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("orientation constraints:"), std::string::npos) << out;
+  const auto before = read_json(plain + "/report.json"),
+             after = read_json(oriented + "/report.json");
+  const int folds = before["metrics"]["foldovers"].get<int>();
+  ASSERT_GT(folds, 0);
+  EXPECT_FALSE(before.contains("fold_removal"));
+  EXPECT_EQ(after["metrics"]["foldovers"].get<int>(), 0);
+  EXPECT_TRUE(after["structurally_equivalent"].get<bool>());
+  EXPECT_EQ(after["bad_cones"].get<int>(), 0);
+  const auto& removal = after["fold_removal"];
+  EXPECT_EQ(removal["method"], "orientation");
+  EXPECT_EQ(removal["foldovers_before"].get<int>(), folds);
+  EXPECT_EQ(removal["foldovers_after"].get<int>(), 0);
+  EXPECT_TRUE(removal["orientation"]["ran"].get<bool>());
+  EXPECT_GT(removal["orientation"]["constrained_faces"].get<int>(), 0);
+  // The nodes did not move: the same node vertices in both output layouts.
+  const Layout l0 = load_layout(plain + "/layout.json", load_mesh(kMesh));
+  const Layout l1 = load_layout(oriented + "/layout.json", load_mesh(kMesh));
+  ASSERT_EQ(l0.nodes.size(), l1.nodes.size());
+  for (size_t i = 0; i < l0.nodes.size(); ++i) EXPECT_EQ(l0.nodes[i].vertex, l1.nodes[i].vertex);
+  // A fold-free input: nothing to remove, the same parameterization as without the flag.
+  const std::string exact = test::temp_dir("cli_exact_oriented");
+  ASSERT_EQ(test::run_command(cli("optimize --no-node-opt --orientation --quiet --mesh " + kMesh +
+                                  " --layout " + kExact + " --out " + exact),
+                              &out),
+            0)
+      << out;
+  const auto exact_report = read_json(exact + "/report.json");
+  EXPECT_EQ(exact_report["fold_removal"]["method"], "none");
+  EXPECT_EQ(exact_report["fold_removal"]["foldovers_before"].get<int>(), 0);
+  EXPECT_FALSE(exact_report["fold_removal"]["orientation"]["ran"].get<bool>());
+  // Refused combinations: exit code 2 with the reason.
+  EXPECT_EQ(test::run_command(cli("optimize --orientation" + files + " --out " + plain), &out), 2);
+  EXPECT_NE(out.find("--orientation applies to --no-node-opt"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(cli("optimize --no-node-opt --orientation --no-orientation" + files +
+                                  " --out " + plain),
+                              &out),
+            2);
+  EXPECT_NE(out.find("contradict"), std::string::npos) << out;
+}
+
 // Sliding along the boundary from the command line: a boundary node of a flat grid layout two
 // edges off its place slides back by default (report: sliding_nodes), stays with --no-sliding;
 // --keep-sharp-edges is accepted (the flat grid has no sharp edges: the same result).

@@ -89,6 +89,10 @@ int main(int argc, char** argv) {
                     "Treat the sharp edges (--sharp-angle) as feature curves in the node "
                     "optimization: nodes on them slide along them and their vertices keep their "
                     "place (sharp edges keep their shape; higher E)");
+  cmd_opt->add_flag("--orientation", opt.orientation,
+                    "With --no-node-opt: when the parameterization has fold-overs, solve it "
+                    "again with strict orientation constraints (the fixed nodes' fold-over "
+                    "removal; the node optimization does this by default)");
   cmd_opt->add_flag("--no-orientation", opt.no_orientation,
                     "No orientation constraints against fold-overs after the node optimization "
                     "(stiffening only)");

@@ -42,6 +42,18 @@ class ProgressPrinter : public Observer {
   bool quiet_;
 };
 
+// The report's account of one orientation-constrained solve.
+nlohmann::json orientation_json(const OrientationReport& r) {
+  return {{"ran", r.ran},
+          {"success", r.success},
+          {"constrained_faces", r.constrained_faces},
+          {"all_faces", r.all_faces},
+          {"rounds", r.rounds},
+          {"iterations", r.iterations},
+          {"time_s", r.time_s},
+          {"message", r.message}};
+}
+
 }  // namespace
 
 int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
@@ -104,6 +116,18 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
         options.param.orientation = result.orientation_options;
       node_result = std::move(result);
     };
+    if (o.orientation && !o.no_node_opt)
+      throw InvalidInputError(
+          "--orientation applies to --no-node-opt runs (the node optimization removes "
+          "fold-overs with orientation constraints by default; --no-orientation turns that off)");
+    if (o.orientation && o.no_orientation)
+      throw InvalidInputError("--orientation and --no-orientation contradict each other");
+    // --no-node-opt --orientation: the final solve checks for fold-overs and, when there are
+    // any, solves the orientation-constrained QP (ParamSolver::solve), cancellable by signal.
+    if (o.orientation) {
+      options.param.orientation.enabled = true;
+      options.param.orientation.observer = &printer;
+    }
     if (!o.no_node_opt) {
       t0 = std::chrono::steady_clock::now();
       adopt(optimize(mesh, layout, options));
@@ -135,6 +159,8 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       fixed.param.arc_lengths = integer->lengths;
       fixed.param.face_weights.clear();
       fixed.param.orientation = PipelineOptions{}.param.orientation;
+      fixed.param.orientation.enabled = o.orientation;  // --no-node-opt --orientation
+      if (o.orientation) fixed.param.orientation.observer = &printer;
       options = fixed;
       if (!o.no_node_opt) {
         t0 = std::chrono::steady_clock::now();
@@ -201,15 +227,18 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
           {"fold_removal", node_result->orientation_constraints ? "orientation"
                            : !node_result->face_weights.empty() ? "stiffening"
                                                                 : "none"},
-          {"orientation",
-           {{"ran", node_result->orientation.ran},
-            {"success", node_result->orientation.success},
-            {"constrained_faces", node_result->orientation.constrained_faces},
-            {"all_faces", node_result->orientation.all_faces},
-            {"rounds", node_result->orientation.rounds},
-            {"iterations", node_result->orientation.iterations},
-            {"time_s", node_result->orientation.time_s},
-            {"message", node_result->orientation.message}}}};
+          {"orientation", orientation_json(node_result->orientation)}};
+    }
+    if (o.orientation) {  // --no-node-opt --orientation
+      const OrientationReport& r = param.orientation;
+      report["fold_removal"] = {{"method", r.success ? "orientation" : "none"},
+                                {"foldovers_before", r.ran ? r.foldovers_before : param.foldovers},
+                                {"foldovers_after", param.foldovers},
+                                {"orientation", orientation_json(r)}};
+      if (!common.quiet && r.ran)
+        std::cerr << "optimize: orientation constraints: " << r.foldovers_before << " -> "
+                  << param.foldovers << " fold-overs"
+                  << (r.success ? "" : " (not used: " + r.message + ")") << "\n";
     }
     if (integer) {
       double worst = 0;  // largest deviation of a patch side from a multiple of Q (relative)

@@ -33,7 +33,10 @@ struct OptimizeOptions {
   std::string gradient = "estimator";
   bool no_align = false;
   bool discrete_relocation = false;
-  bool no_orientation = false;    //!< no orientation constraints after the node optimization
+  bool no_orientation = false;  //!< no orientation constraints after the node optimization
+  //! With no_node_opt: the parameterization with strict orientation constraints when it folds
+  //! (ParamOptions::orientation, paper §7.2), as the node optimization's last solve does.
+  bool orientation = false;
   bool no_sliding = false;        //!< nodes on curves stay (NodeOptOptions::slide_on_curves off)
   bool keep_sharp_edges = false;  //!< NodeOptOptions::sharp_edges_as_curves
   //! Curl-reducing sizing field (ParamOptions::sizing); unset: the library default.
