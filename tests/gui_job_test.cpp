@@ -121,6 +121,40 @@ TEST(GuiJob, DisplayedStepMatchesFreshSolve) {
   ASSERT_EQ(s->exports->corner_uv.size(), fresh.parameterization()->corner_uv.size());
 }
 
+// Without node optimization the sketch's fixed nodes fold; with "Remove fold-overs" the job's
+// one solve adds the orientation constraints (as `optimize --no-node-opt --orientation`): no
+// fold-over, an equivalent layout, the same node vertices, and the message says what happened.
+TEST(GuiJob, FixedNodesRemoveFoldoversWhenAsked) {
+  const Example ex = example();
+  WorkerOptions options = steps(1);
+  options.node_optimization = false;
+  const auto plain = test::run_job(ex, options);
+  ASSERT_EQ(plain->status, WorkerStatus::Finished) << plain->message;
+  ASSERT_GT(plain->metrics.foldovers, 0) << plain->message;
+  EXPECT_EQ(plain->message.find("orientation"), std::string::npos) << plain->message;
+  options.remove_foldovers = true;
+  const auto oriented = test::run_job(ex, options);
+  ASSERT_EQ(oriented->status, WorkerStatus::Finished) << oriented->message;
+  EXPECT_EQ(oriented->metrics.foldovers, 0) << oriented->message;
+  EXPECT_NE(oriented->message.find("structurally equivalent"), std::string::npos)
+      << oriented->message;
+  EXPECT_EQ(oriented->message.find("NOT structurally"), std::string::npos) << oriented->message;
+  EXPECT_NE(oriented->message.find("by orientation constraints"), std::string::npos)
+      << oriented->message;
+  ASSERT_TRUE(plain->exports && oriented->exports);
+  const Layout& a = plain->exports->layout;
+  const Layout& b = oriented->exports->layout;
+  ASSERT_EQ(a.nodes.size(), b.nodes.size());
+  for (size_t n = 0; n < a.nodes.size(); ++n) EXPECT_EQ(a.nodes[n].vertex, b.nodes[n].vertex);
+  // With node optimization on, the option changes nothing (the optimizer removes fold-overs
+  // at its end anyway): the initial solve still shows the sketch's fold-overs.
+  WorkerOptions with_nodeopt = steps(1);
+  with_nodeopt.remove_foldovers = true;
+  const auto first = test::run_job(ex, with_nodeopt);
+  ASSERT_EQ(first->status, WorkerStatus::Finished) << first->message;
+  EXPECT_EQ(first->metrics.foldovers, plain->metrics.foldovers) << first->message;
+}
+
 // A run with the default settings ends where `quadsketch-cli optimize` ends (without
 // stiffening, which the editor leaves out): the same units (descent steps, hop sweeps,
 // fold-over removal), so the same final mesh and node vertices, below the descent alone.

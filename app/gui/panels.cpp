@@ -424,6 +424,14 @@ void App::draw_pipeline_options() {
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("Initial damping factor of the node steps; halved after a rejected step");
   if (!o.node_optimization) ImGui::EndDisabled();
+  if (o.node_optimization) ImGui::BeginDisabled();
+  ImGui::Checkbox("Remove fold-overs", &o.remove_foldovers);
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip(
+        "Without node optimization: when the parameterization of the fixed nodes folds, solve "
+        "it again with strict orientation constraints (--no-node-opt --orientation). Node "
+        "optimization always does this at its end");
+  if (o.node_optimization) ImGui::EndDisabled();
   ImGui::PopItemWidth();
   // Clamp typed values (Ctrl+click) to what the pipeline accepts.
   o.sharp_angle_deg = std::clamp(o.sharp_angle_deg, 1.0, 180.0);
@@ -442,6 +450,7 @@ void App::draw_pipeline_options() {
     o.max_steps = defaults.max_steps;
     o.descent_steps = defaults.descent_steps;
     o.keep_sharp_edges = defaults.keep_sharp_edges;
+    o.remove_foldovers = defaults.remove_foldovers;
     o.alpha = defaults.alpha;
   }
   ImGui::SameLine();

@@ -230,10 +230,26 @@ StepResult pipeline_step(WorkerState& state, const WorkerObserver& observer) {
       if (node.pinned) job->pinned_in_layout.insert(node.id);
     state.user = job;
     const bool last = !state.options.node_optimization || state.options.max_steps <= 1;
+    // Fixed nodes with fold-over removal: the solve checks for fold-overs and runs the
+    // orientation-constrained QP when there are any (polling the worker for cancellation).
+    const bool orient = !state.options.node_optimization && state.options.remove_foldovers;
+    if (orient) {
+      job->options.param.orientation.enabled = true;
+      job->options.param.orientation.observer = &observer;
+    }
     StepResult result = solve_for_display(*job, state, observer, last);
+    job->options.param.orientation.observer = nullptr;  // valid during this call only
     job->metrics = result.metrics;
     result.finished = !state.options.node_optimization;
     result.message = "initial solve: " + result.message;
+    if (orient && job->pipeline && job->pipeline->parameterization()) {
+      const OrientationReport& r = job->pipeline->parameterization()->orientation;
+      if (r.ran)
+        result.message += "; fold-overs " + std::to_string(r.foldovers_before) + " -> " +
+                          std::to_string(job->pipeline->parameterization()->foldovers) +
+                          " by orientation constraints" +
+                          (r.success ? "" : " (not used: " + r.message + ")");
+    }
     result.metrics.total_ms = ms_since(start);
     return result;
   }

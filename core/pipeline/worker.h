@@ -47,6 +47,10 @@ struct WorkerOptions {
   double alpha = 0.75;            //!< initial damping α of node-optimization steps
   int descent_steps = 25;         //!< descent steps before the first hop sweep (--steps)
   bool keep_sharp_edges = false;  //!< sharp edges as feature curves (--keep-sharp-edges)
+  //! Without node optimization: when the parameterization folds, solve it again with strict
+  //! orientation constraints (`optimize --no-node-opt --orientation`); the node optimization
+  //! removes fold-overs at its end in any case.
+  bool remove_foldovers = false;
 };
 
 //! What a step function sees of the job: a qs::Observer, so it can be handed straight to
