@@ -233,12 +233,16 @@ StepResult pipeline_step(WorkerState& state, const WorkerObserver& observer) {
     // Fixed nodes with fold-over removal: the solve checks for fold-overs and runs the
     // orientation-constrained QP when there are any (polling the worker for cancellation).
     const bool orient = !state.options.node_optimization && state.options.remove_foldovers;
+    // The observer pointer is valid during this call only: cleared on every exit.
+    struct ClearObserver {
+      PipelineOptions& options;
+      ~ClearObserver() { options.param.orientation.observer = nullptr; }
+    } clear_observer{job->options};
     if (orient) {
       job->options.param.orientation.enabled = true;
       job->options.param.orientation.observer = &observer;
     }
     StepResult result = solve_for_display(*job, state, observer, last);
-    job->options.param.orientation.observer = nullptr;  // valid during this call only
     job->metrics = result.metrics;
     result.finished = !state.options.node_optimization;
     result.message = "initial solve: " + result.message;
