@@ -74,6 +74,12 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     if (o.sizing) options.param.sizing.enabled = *o.sizing;
     if (o.integer && !(o.quad_size > 0 || o.quad_count > 0))
       throw InvalidInputError("--integer needs --quad-size Q or --quad-count N");
+    if (o.orientation && !o.no_node_opt)
+      throw InvalidInputError(
+          "--orientation applies to --no-node-opt runs (the node optimization removes "
+          "fold-overs with orientation constraints by default; --no-orientation turns that off)");
+    if (o.orientation && o.no_orientation)
+      throw InvalidInputError("--orientation and --no-orientation contradict each other");
     // Node optimization first (it runs its own field + parameterization solves); the final
     // stages below then run on its result.
     double node_s = 0;
@@ -116,12 +122,6 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
         options.param.orientation = result.orientation_options;
       node_result = std::move(result);
     };
-    if (o.orientation && !o.no_node_opt)
-      throw InvalidInputError(
-          "--orientation applies to --no-node-opt runs (the node optimization removes "
-          "fold-overs with orientation constraints by default; --no-orientation turns that off)");
-    if (o.orientation && o.no_orientation)
-      throw InvalidInputError("--orientation and --no-orientation contradict each other");
     // --no-node-opt --orientation: the final solve checks for fold-overs and, when there are
     // any, solves the orientation-constrained QP (ParamSolver::solve), cancellable by signal.
     if (o.orientation) {
@@ -158,9 +158,9 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       PipelineOptions fixed = options;
       fixed.param.arc_lengths = integer->lengths;
       fixed.param.face_weights.clear();
-      fixed.param.orientation = PipelineOptions{}.param.orientation;
-      fixed.param.orientation.enabled = o.orientation;  // --no-node-opt --orientation
-      if (o.orientation) fixed.param.orientation.observer = &printer;
+      // The node optimizer's constrained solve is not carried over; --no-node-opt --orientation
+      // keeps its own (set above: no node optimization has replaced it).
+      if (!o.orientation) fixed.param.orientation = PipelineOptions{}.param.orientation;
       options = fixed;
       if (!o.no_node_opt) {
         t0 = std::chrono::steady_clock::now();
