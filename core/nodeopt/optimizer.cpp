@@ -697,7 +697,15 @@ struct NodeOptimizer::Impl {
     check_cancel(observer);
     const auto t_step = std::chrono::steady_clock::now();
     if (state_changed) {
-      // Gradients at the current solution.
+      // Node-Voronoi cells on the original mesh, from all node vertices: on the second thread
+      // while the gradients are computed (they only read the original mesh and the node list).
+      std::vector<int> all_vertices;
+      for (const auto& n : state.layout.nodes) all_vertices.push_back(n.vertex);
+      std::future<std::vector<int>> cells;
+      if (options.param.second_thread)
+        cells = std::async(std::launch::async,
+                           [this, &all_vertices] { return node_voronoi_cells(original, all_vertices); });
+      // Gradients at the current solution (the future waits in its destructor if they throw).
       std::vector<int> vertices;
       for (int n : movable) vertices.push_back(state.layout.nodes[n].vertex);
       if (no.gradient == GradientMethod::Exact) {
@@ -710,10 +718,7 @@ struct NodeOptimizer::Impl {
                                        *p.parameterization(), options.param, vertices);
         scale = no.estimator_scale;
       }
-      // Node-Voronoi cells on the original mesh, from all node vertices.
-      std::vector<int> all_vertices;
-      for (const auto& n : state.layout.nodes) all_vertices.push_back(n.vertex);
-      cell = node_voronoi_cells(original, all_vertices);
+      cell = cells.valid() ? cells.get() : node_voronoi_cells(original, all_vertices);
       state_changed = false;
     } else {
       ++counters.gradient_reuses;

@@ -340,20 +340,17 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
   }
   // Explicit feature edges (layout "features") that are not arcs: iso-lines of the field's
   // matching parameter.
-  {
-    const std::vector<char> arc_edge = arc_edge_mask(mesh, layout);
-    for (const auto& [a, b] : layout.feature_edges) {
-      auto h = mesh.find_halfedge(mesh.vertex_handle(a), mesh.vertex_handle(b));
-      if (!h.is_valid() || arc_edge[mesh.edge_handle(h).idx()]) continue;
-      if (mesh.is_boundary(h)) h = mesh.opposite_halfedge_handle(h);
-      const int f = mesh.face_handle(h).idx();
-      const Vec3 t = mesh.point(mesh.vertex_handle(b)) - mesh.point(mesh.vertex_handle(a));
-      const double rel = g.angle_in_face(f, t) - theta[f];
-      const bool along_u = std::lround(rel / (M_PI / 2)) % 2 == 0;
-      const Lin2 d = sub(corner_expr(g, cut_, f, b), corner_expr(g, cut_, f, a));
-      const int o = system_.add_origin("feature edge " + edge_name(a, b));
-      add_row(along_u ? d.v : d.u, 0.0, o);
-    }
+  feature_directions_ = feature_edge_directions(mesh, g, layout, theta);
+  for (size_t i = 0; i < layout.feature_edges.size(); ++i) {
+    if (feature_directions_[i] < 0) continue;
+    const auto [a, b] = layout.feature_edges[i];
+    auto h = mesh.find_halfedge(mesh.vertex_handle(a), mesh.vertex_handle(b));
+    if (mesh.is_boundary(h)) h = mesh.opposite_halfedge_handle(h);
+    const int f = mesh.face_handle(h).idx();
+    const bool along_u = feature_directions_[i] == 1;
+    const Lin2 d = sub(corner_expr(g, cut_, f, b), corner_expr(g, cut_, f, a));
+    const int o = system_.add_origin("feature edge " + edge_name(a, b));
+    add_row(along_u ? d.v : d.u, 0.0, o);
   }
   reduction_ = eliminate_constraints(system_);
   assembly_ = ReducedAssembly(cut_.corner_wedge, cut_.wedges, system_.variables, reduction_.Z);
@@ -380,6 +377,40 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
 }
 
 ParamSolver::~ParamSolver() = default;
+
+std::vector<signed char> ParamSolver::feature_edge_directions(const TriMesh& mesh,
+                                                              const GeometryCache& g,
+                                                              const Layout& layout,
+                                                              const std::vector<double>& theta) {
+  std::vector<signed char> out(layout.feature_edges.size(), -1);
+  if (out.empty()) return out;
+  const std::vector<char> arc_edge = arc_edge_mask(mesh, layout);
+  for (size_t i = 0; i < out.size(); ++i) {
+    const auto [a, b] = layout.feature_edges[i];
+    auto h = mesh.find_halfedge(mesh.vertex_handle(a), mesh.vertex_handle(b));
+    if (!h.is_valid() || arc_edge[mesh.edge_handle(h).idx()]) continue;
+    if (mesh.is_boundary(h)) h = mesh.opposite_halfedge_handle(h);
+    const int f = mesh.face_handle(h).idx();
+    const Vec3 t = mesh.point(mesh.vertex_handle(b)) - mesh.point(mesh.vertex_handle(a));
+    const double rel = g.angle_in_face(f, t) - theta[f];
+    out[i] = std::lround(rel / (M_PI / 2)) % 2 == 0 ? 1 : 0;
+  }
+  return out;
+}
+
+bool ParamSolver::adopt_field(const TriMesh& mesh, const GeometryCache& g, const Layout& layout,
+                              const LayoutTopology& topology, const std::vector<int>& p,
+                              const std::vector<double>& theta) {
+  if (p != period_jump_ || feature_edge_directions(mesh, g, layout, theta) != feature_directions_)
+    return false;
+  Labeling labels = label_layout(mesh, g, layout, topology, p, theta);
+  // The rows see a symbol's parity only (which parameter is constant along the arc): symbols
+  // that all differ by a half turn give the same system.
+  for (size_t h = 0; h < labels.symbol.size(); ++h)
+    if (labels.symbol[h] % 2 != labeling_.symbol[h] % 2) return false;
+  labeling_ = std::move(labels);  // its symbols and diagnostics for θ (extraction reads them)
+  return true;
+}
 
 std::vector<ArcLength> ParamSolver::arc_lengths() const {
   // Wedge values from the corner values (every corner of a wedge has the same (u, v)).

@@ -104,6 +104,19 @@ class ParamSolver {
               ParamSolver* previous = nullptr, bool solve_now = true);
   ~ParamSolver();
 
+  //! For a solver built with \p solve_now false from a guess of the field (Pipeline: the
+  //! previous step's θ, while the new field is solved): true when it is the solver a
+  //! construction for \p period_jump and \p theta would build: the period jumps are these, and
+  //! \p theta gives the same feature-edge directions and arc labels up to a half turn (the rows
+  //! see a label's parity only), so every constraint row is the same. It then takes \p theta's
+  //! labeling (symbols and diagnostics for \p theta). False: the solver is unchanged and not
+  //! for this field. \p mesh, \p geometry, \p layout, \p topology: as at construction (same positions
+  //! not required: the rows are combinatorial).
+  //! \throw TopologyError as the constructor (labels).
+  bool adopt_field(const TriMesh& mesh, const GeometryCache& geometry, const Layout& layout,
+                   const LayoutTopology& topology, const std::vector<int>& period_jump,
+                   const std::vector<double>& theta);
+
   //! Assembles the energy for the current geometry and field and solves; reuses the symbolic
   //! factorization.
   const Parameterization& solve(const TriMesh& mesh, const GeometryCache& geometry,
@@ -154,6 +167,13 @@ class ParamSolver {
     double constant = 0;
   };
   std::vector<ArcSpan> arc_spans_;
+  //! Per Layout::feature_edges entry: 1 iso-line of v (along u), 0 of u, -1 no row (an arc edge
+  //! or not a mesh edge). From the field's θ at construction.
+  std::vector<signed char> feature_directions_;
+  static std::vector<signed char> feature_edge_directions(const TriMesh& mesh,
+                                                          const GeometryCache& geometry,
+                                                          const Layout& layout,
+                                                          const std::vector<double>& theta);
   //! With ParamOptions::wedge_ordering, hands the wedge-graph ordering of \p A to the linear
   //! solver when its next factorization analyzes (A's pattern is not the analyzed one).
   void hint_ordering(const Eigen::SparseMatrix<double>& A);

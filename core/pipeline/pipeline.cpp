@@ -1,10 +1,12 @@
 #include "core/pipeline/pipeline.h"
 
 #include <cstdio>
+#include <future>
 #include <sstream>
 
 #include "core/base/atomic_file.h"
 #include "core/base/errors.h"
+#include "core/field/topology.h"
 
 namespace qs {
 
@@ -52,6 +54,7 @@ void Pipeline::update_positions(const TriMesh& mesh) {
   update_geometry(mesh_, geometry_);
   curvature_.reset();
   extraction_.reset();
+  prepared_param_.reset();
 }
 
 void Pipeline::unshare_solvers() {
@@ -62,15 +65,20 @@ const CrossField& Pipeline::compute_field() {
   if (!field_solver_) {
     // Split clusters are judged against the layout's own field, whose global rotation is
     // free: it gets the rotation the parameterization would choose for it, as for a field
-    // without constraints (docs/benchmarks.md, session 15). The solver is not kept: its u/v
-    // labels follow the unrotated field (compute_parameterization labels the final one).
+    // without constraints (docs/benchmarks.md, session 15). Its u/v labels follow the
+    // unrotated field: compute_parameterization keeps the solver only when the final field
+    // gives the same constraint rows (ParamSolver::adopt_field), else builds one.
+    prepared_param_.reset();
     CrossFieldSolver::ReferenceRotation rotation;
     if (options_.field.max_cluster_faces > 0)
       rotation = [this](const std::vector<int>& period_jump, const std::vector<double>& theta) {
         try {
-          ParamSolver solver(mesh_, geometry_, layout_, topology_, period_jump, theta,
-                             options_.param, nullptr, /*solve_now=*/false);
-          return solver.optimal_field_rotation(mesh_, geometry_, theta);
+          auto solver =
+              std::make_unique<ParamSolver>(mesh_, geometry_, layout_, topology_, period_jump,
+                                            theta, options_.param, nullptr, /*solve_now=*/false);
+          const double phi = solver->optimal_field_rotation(mesh_, geometry_, theta);
+          prepared_param_ = std::move(solver);
+          return phi;
         } catch (const QsError&) {
           return 0.0;  // compute_parameterization() reports it
         }
@@ -80,8 +88,34 @@ const CrossField& Pipeline::compute_field() {
     return field_solver_->field();
   }
   if (field_layout_stale_) {
+    // The parameterization's combinatorial setup (cut graph, labels, constraint elimination,
+    // the reduced matrix's pattern and its symbolic analysis) needs the period jumps, and θ
+    // only for the arc labels' global u/v choice and the feature edges' directions: it is
+    // built on the second thread from the last field's θ while the field is solved, and
+    // compute_parameterization() keeps it when the solved field gives the same rows
+    // (ParamSolver::adopt_field), else builds one as before. Joined before returning (also
+    // when update_layout throws: the future waits in its destructor), so it never outlives
+    // this call's use of the members.
+    prepared_param_.reset();
+    std::future<std::unique_ptr<ParamSolver>> prepared;
+    if (options_.param.second_thread)
+      prepared = std::async(std::launch::async,
+                            [this, theta = field_solver_->field().theta]() {
+                              std::unique_ptr<ParamSolver> solver;
+                              try {
+                                const std::vector<int> p =
+                                    compute_period_jumps(mesh_, geometry_, layout_, topology_);
+                                solver = std::make_unique<ParamSolver>(
+                                    mesh_, geometry_, layout_, topology_, p, theta, options_.param,
+                                    nullptr, /*solve_now=*/false);
+                              } catch (const QsError&) {
+                                // compute_parameterization()'s own construction reports it
+                              }
+                              return solver;
+                            });
     const CrossField& f = field_solver_->update_layout(mesh_, geometry_, layout_, topology_);
     field_layout_stale_ = false;
+    if (prepared.valid()) prepared_param_ = prepared.get();
     return f;
   }
   return field_solver_->solve(geometry_);
@@ -108,10 +142,16 @@ const Parameterization& Pipeline::compute_parameterization() {
     // minimizes the energy, not an arbitrary anchor (that would depend on arc routing); the
     // solver's first solve waits until it is chosen.
     const bool free_rotation = field.gauge_face >= 0;
-    param_solver_ =
-        std::make_unique<ParamSolver>(mesh_, geometry_, layout_, topology_, field.period_jump,
-                                      field.theta, options_.param, nullptr, !free_rotation);
-    if (!free_rotation) return param_solver_->result();
+    std::unique_ptr<ParamSolver> prepared = std::move(prepared_param_);
+    if (prepared && prepared->adopt_field(mesh_, geometry_, layout_, topology_,
+                                          field.period_jump, field.theta)) {
+      param_solver_ = std::move(prepared);  // not solved yet: the solve below
+    } else {
+      param_solver_ =
+          std::make_unique<ParamSolver>(mesh_, geometry_, layout_, topology_, field.period_jump,
+                                        field.theta, options_.param, nullptr, !free_rotation);
+      if (!free_rotation) return param_solver_->result();
+    }
   }
   if (field.gauge_face >= 0)
     field_solver_->rotate(param_solver_->optimal_field_rotation(mesh_, geometry_, field.theta));
