@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Sanitizer CI (issue #10): every unit test under ASan+UBSan (build-asan, no GUI), the
-# threading tests (worker, SpdSolver, the parameterization's second thread) under TSan
+# threading tests (worker, SpdSolver, the parameterization's second thread, the parameterization
+# set up beside the field) under TSan
 # (build-tsan). Tests labelled "slow" are left out.
 # Usage: scripts/ci-sanitizers.sh [asan|tsan]...   (default: both)
 # QS_SANITIZER_BUILD_ROOT puts the build folders elsewhere (default: the repository).
@@ -40,13 +41,15 @@ for step in "${steps[@]}"; do
     tsan)
       configure "$root/build-tsan" -DQS_SANITIZE=thread
       cmake --build "$root/build-tsan" -j"$jobs" \
-        --target worker_test spd_solver_test param_test nodeopt_test
+        --target worker_test spd_solver_test param_test nodeopt_test reuse_test
       "$root/build-tsan/tests/worker_test" --gtest_brief=1
       "$root/build-tsan/tests/spd_solver_test" --gtest_brief=1
       "$root/build-tsan/tests/param_test" --gtest_brief=1 \
         --gtest_filter='Parameterization.SecondThread*'
       "$root/build-tsan/tests/nodeopt_test" --gtest_brief=1 \
         --gtest_filter='NodeOptimizer.Parallel*:DiscreteRelocation.Parallel*'
+      "$root/build-tsan/tests/reuse_test" --gtest_brief=1 \
+        --gtest_filter='ReuseParam.*:ReuseField.ContinuedField*'
       ;;
     *)
       echo "ci-sanitizers: unknown step '$step' (asan or tsan)" >&2

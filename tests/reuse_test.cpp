@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <random>
 
 #include "core/field/curvature.h"
@@ -214,6 +215,144 @@ TEST(ReuseField, IncrementalGeometryIsBitIdentical) {
   set_frame_offsets(mesh, fresh, offsets);
   for (int e = 0; e < g.n_edges; ++e)
     EXPECT_NEAR(std::remainder(g.kappa[e] - fresh.kappa[e], 2 * M_PI), 0.0, 1e-12) << "edge " << e;
+}
+
+// Largest |Δu|, |Δv| over all corners, relative to the parameter range of \p a.
+double corner_gap(const std::vector<std::array<double, 2>>& a,
+                  const std::vector<std::array<double, 2>>& b) {
+  EXPECT_EQ(a.size(), b.size());
+  double range = 0, gap = 0;
+  for (size_t c = 0; c < a.size() && c < b.size(); ++c)
+    for (int i = 0; i < 2; ++i) {
+      range = std::max(range, std::abs(a[c][i]));
+      gap = std::max(gap, std::abs(a[c][i] - b[c][i]));
+    }
+  return gap / std::max(range, 1e-300);
+}
+
+// A parameterization solver set up for one field (solve_now false) is kept for another only
+// when the constraint rows are the same: same period jumps, same feature-edge directions, arc
+// labels equal up to a half turn. Adopted, it solves exactly as a solver built for that field.
+TEST(ReuseParam, AdoptsASolverSetUpForAnotherFieldOnlyWithTheSameRows) {
+  auto cs = test::cube_sphere(8, Vec3(2.0, 1.0, 0.6));
+  const TriMesh& mesh = cs.mesh;
+  const GeometryCache g = build_geometry(mesh);
+  Layout layout = cs.layout;
+  // A feature edge that is not an arc edge, away from the nodes (their chart faces).
+  const std::vector<char> arc_edge = arc_edge_mask(mesh, layout);
+  std::vector<char> near_node(g.n_vertices, 0);
+  for (const auto& n : layout.nodes)
+    for (int v : test::ring_vertices(mesh, n.vertex, 2)) near_node[v] = 1;
+  int feature_face = -1;
+  for (auto e : mesh.edges()) {
+    const auto h = mesh.halfedge_handle(e, 0);
+    const int a = mesh.from_vertex_handle(h).idx(), b = mesh.to_vertex_handle(h).idx();
+    if (arc_edge[e.idx()] || near_node[a] || near_node[b] || mesh.is_boundary(e)) continue;
+    layout.feature_edges.push_back({a, b});
+    feature_face = mesh.face_handle(h).idx();
+    break;
+  }
+  ASSERT_GE(feature_face, 0);
+  const LayoutTopology topo = build_topology(mesh, layout);
+  const CrossField field = compute_cross_field(mesh, g, layout, topo);
+  const std::vector<int>& p = field.period_jump;
+  auto shifted = [&](double phi) {
+    std::vector<double> t = field.theta;
+    for (double& x : t) x += phi;
+    return t;
+  };
+  auto symbols = [&](const std::vector<double>& theta) {
+    return label_layout(mesh, g, layout, topo, p, theta).symbol;
+  };
+  auto prepared = [&] {
+    return std::make_unique<ParamSolver>(mesh, g, layout, topo, p, field.theta, ParamOptions{},
+                                         nullptr, /*solve_now=*/false);
+  };
+
+  // A half turn: every label moves by 2, the rows stay. Adopted: the labels for θ + π and the
+  // solution of a solver built for θ + π.
+  {
+    const std::vector<double> theta = shifted(M_PI);
+    const std::vector<int> s0 = symbols(field.theta), s1 = symbols(theta);
+    ASSERT_NE(s0, s1) << "the half turn should move the labels";
+    for (size_t h = 0; h < s0.size(); ++h) ASSERT_EQ((s0[h] + 2) % 4, s1[h]);
+    auto solver = prepared();
+    ASSERT_TRUE(solver->adopt_field(mesh, g, layout, topo, p, theta));
+    EXPECT_EQ(solver->labeling().symbol, s1);
+    const Parameterization& adopted = solver->solve(mesh, g, theta);
+    ParamSolver built(mesh, g, layout, topo, p, theta);
+    EXPECT_LT(corner_gap(built.result().corner_uv, adopted.corner_uv), 1e-12);
+    EXPECT_NEAR(adopted.energy, built.result().energy, 1e-12 * built.result().energy);
+    EXPECT_EQ(adopted.foldovers, built.result().foldovers);
+  }
+  // A quarter turn swaps u and v on every arc: other rows.
+  {
+    const std::vector<double> theta = shifted(M_PI / 2);
+    const std::vector<int> s0 = symbols(field.theta), s1 = symbols(theta);
+    ASSERT_NE(s0[0] % 2, s1[0] % 2) << "the quarter turn should change the labels' parity";
+    auto solver = prepared();
+    EXPECT_FALSE(solver->adopt_field(mesh, g, layout, topo, p, theta));
+    EXPECT_EQ(solver->labeling().symbol, s0);  // unchanged
+  }
+  // The feature edge's face turned by a quarter: same labels, the feature row changes.
+  {
+    std::vector<double> theta = field.theta;
+    theta[feature_face] += M_PI / 2;
+    ASSERT_EQ(symbols(theta), symbols(field.theta));
+    auto solver = prepared();
+    EXPECT_FALSE(solver->adopt_field(mesh, g, layout, topo, p, theta));
+  }
+  // Other period jumps (one edge's jump by a full turn, the same modulo 4).
+  {
+    std::vector<int> other = p;
+    other[0] += 4;
+    auto solver = prepared();
+    EXPECT_FALSE(solver->adopt_field(mesh, g, layout, topo, other, field.theta));
+    EXPECT_TRUE(solver->adopt_field(mesh, g, layout, topo, p, field.theta));
+  }
+}
+
+// Pipelines use the solvers set up ahead (a fresh one the reference rotation's, a continued one
+// the solver set up beside update_layout) and get the parameterization they would get without
+// them: a solver built for the final field, and a continued pipeline without the second thread.
+TEST(ReuseParam, PreparedSolversGiveTheSameParameterization) {
+  const auto cs = test::cube_sphere(8, Vec3(2.0, 1.0, 0.6));
+  const Example ex{cs.mesh, cs.layout};
+  const PipelineOptions options;
+  ASSERT_GT(options.field.max_cluster_faces, 0) << "split clusters: the reference rotation";
+  Pipeline first(ex.mesh, ex.layout, options);
+  first.compute_field();
+  const Parameterization& r0 = first.compute_parameterization();
+  EXPECT_TRUE(first.param_solver_prepared());
+  {
+    ParamSolver built(first.mesh(), first.geometry(), first.layout(), first.topology(),
+                      first.field()->period_jump, first.field()->theta, options.param);
+    EXPECT_LT(corner_gap(built.result().corner_uv, r0.corner_uv), 1e-12);
+    EXPECT_EQ(built.labeling().symbol, first.param_solver()->labeling().symbol);
+  }
+  PipelineOptions one_thread = options;
+  one_thread.param.second_thread = false;
+  Pipeline first_one(ex.mesh, ex.layout, one_thread);
+  first_one.compute_parameterization();
+  int adopted = 0;
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const Layout moved = moved_layout(ex.mesh, ex.layout, seed);
+    const TriMesh mesh = relocated(ex.mesh, ex.layout, 0.3, seed);
+    Pipeline continued(mesh, moved, first);
+    continued.compute_field();
+    const Parameterization& r = continued.compute_parameterization();
+    Pipeline plain(mesh, moved, first_one);
+    plain.compute_field();
+    const Parameterization& q = plain.compute_parameterization();
+    EXPECT_FALSE(plain.param_solver_prepared());
+    adopted += continued.param_solver_prepared();
+    EXPECT_LT(corner_gap(q.corner_uv, r.corner_uv), 1e-12) << "seed " << seed;
+    EXPECT_EQ(q.foldovers, r.foldovers) << "seed " << seed;
+    EXPECT_EQ(plain.param_solver()->labeling().symbol, continued.param_solver()->labeling().symbol);
+    EXPECT_EQ(plain.param_solver()->labeling().geometric_mismatches,
+              continued.param_solver()->labeling().geometric_mismatches);
+  }
+  EXPECT_GT(adopted, 0) << "no continued pipeline adopted its prepared solver";
 }
 
 }  // namespace

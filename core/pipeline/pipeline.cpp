@@ -146,6 +146,7 @@ const Parameterization& Pipeline::compute_parameterization() {
     if (prepared && prepared->adopt_field(mesh_, geometry_, layout_, topology_,
                                           field.period_jump, field.theta)) {
       param_solver_ = std::move(prepared);  // not solved yet: the solve below
+      param_prepared_ = true;
     } else {
       param_solver_ =
           std::make_unique<ParamSolver>(mesh_, geometry_, layout_, topology_, field.period_jump,

@@ -86,6 +86,10 @@ class Pipeline {
   const Parameterization& compute_parameterization();
   const Parameterization* parameterization() const;
   const ParamSolver* param_solver() const { return param_solver_.get(); }
+  //! Whether the current parameterization solver was set up ahead and adopted (the reference
+  //! rotation's solver of a fresh field, or the one set up beside update_layout), not built
+  //! after the field.
+  bool param_solver_prepared() const { return param_prepared_; }
   //! Traces the arcs on the current parameterization.
   const Extraction& extract();
   //! Metrics of the current parameterization (curvature computed once).
@@ -108,6 +112,7 @@ class Pipeline {
   //! Continued pipelines: the parameterization solver set up beside update_layout from the
   //! previous field (compute_field), until compute_parameterization adopts or drops it.
   std::unique_ptr<ParamSolver> prepared_param_;
+  bool param_prepared_ = false;  //!< param_solver_ was prepared_param_ (param_solver_prepared)
   std::unique_ptr<Extraction> extraction_;
   std::unique_ptr<Curvature> curvature_;
 };
