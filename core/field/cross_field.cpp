@@ -57,7 +57,8 @@ FieldConstraints CrossFieldSolver::current_constraints(const TriMesh& mesh, cons
 
 void CrossFieldSolver::setup(const TriMesh& mesh, const GeometryCache& g, const Layout& layout,
                              const LayoutTopology& topology, FieldConstraints constraints,
-                             int tolerated, const ReferenceRotation& reference_rotation) {
+                             int tolerated, const ReferenceRotation& reference_rotation,
+                             const PeriodJumpSource& period_jumps) {
   const CrossFieldOptions& options = options_;
   // Everything but the kept factorizations starts over (update_layout after the constraint set
   // changed calls this on a used solver).
@@ -67,7 +68,9 @@ void CrossFieldSolver::setup(const TriMesh& mesh, const GeometryCache& g, const 
   field_.dropped_constraints = 0;
   gauge_angle_ = 0;
   auto t0 = std::chrono::steady_clock::now();
-  field_.period_jump = compute_period_jumps(mesh, g, layout, topology, &field_.topology);
+  field_.period_jump = period_jumps
+                           ? period_jumps(&field_.topology)
+                           : compute_period_jumps(mesh, g, layout, topology, &field_.topology);
   field_.timings.period_jumps_s = seconds_since(t0);
 
   t0 = std::chrono::steady_clock::now();
@@ -916,7 +919,8 @@ const CrossField& CrossFieldSolver::solve(const GeometryCache& g) {
 
 const CrossField& CrossFieldSolver::update_layout(const TriMesh& mesh, const GeometryCache& g,
                                                   const Layout& layout,
-                                                  const LayoutTopology& topology) {
+                                                  const LayoutTopology& topology,
+                                                  const PeriodJumpSource& period_jumps) {
   if (g.n_faces != matrix_.rows() || static_cast<int>(mesh.n_faces()) != g.n_faces)
     throw InvalidInputError("cross field: the mesh changed size since the solver was built");
   auto t0 = std::chrono::steady_clock::now();
@@ -931,14 +935,17 @@ const CrossField& CrossFieldSolver::update_layout(const TriMesh& mesh, const Geo
     // same-face path below does: a pass would not remove them, and each costs a factorization.
     // (Session 5: on the 70K bunny 25 steps end at E 0.0354 instead of 0.0405, fewer
     // factorizations; a fresh construction drops until a pass stops helping.)
-    setup(mesh, g, layout, topology, std::move(constraints), residual_mismatches_);
+    setup(mesh, g, layout, topology, std::move(constraints), residual_mismatches_, {},
+          period_jumps);
     return field_;
   }
   // Same faces: only the directions moved (the matrix and the clusters are unchanged).
   field_.constraints.direction = constraints.direction;
   constraint_dir_ = std::move(constraints.direction);
   t0 = std::chrono::steady_clock::now();
-  field_.period_jump = compute_period_jumps(mesh, g, layout, topology, &field_.topology);
+  field_.period_jump = period_jumps
+                           ? period_jumps(&field_.topology)
+                           : compute_period_jumps(mesh, g, layout, topology, &field_.topology);
   field_.timings.period_jumps_s = seconds_since(t0);
   // Cluster membership depends on the constraint set only; the relative rotations on p.
   const std::vector<int> old_cluster = cluster_of_;

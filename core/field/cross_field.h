@@ -127,6 +127,8 @@ class CrossFieldSolver {
   //! field without constraints gets.
   using ReferenceRotation =
       std::function<double(const std::vector<int>& period_jump, const std::vector<double>& theta)>;
+  //! The period jumps of the layout being set up, with their report (update_layout).
+  using PeriodJumpSource = std::function<std::vector<int>(PeriodJumpReport* report)>;
 
   //! \p reference_rotation (optional, split mode): see ReferenceRotation; called at most once,
   //! during construction, and not kept. Without it the layout's own field is pinned along one
@@ -165,8 +167,12 @@ class CrossFieldSolver {
   //! keeps that rotation (fitted to the last reference) where a fresh construction would
   //! choose again, so the descent's field does not jump between steps.
   //! \throw TopologyError as the constructor, InvalidInputError when the mesh size changed.
+  //! \p period_jumps (optional): supplies what compute_period_jumps(mesh, geometry, layout,
+  //! topology, report) returns, e.g. computed on another thread (Pipeline); it may throw that
+  //! function's errors.
   const CrossField& update_layout(const TriMesh& mesh, const GeometryCache& geometry,
-                                  const Layout& layout, const LayoutTopology& topology);
+                                  const Layout& layout, const LayoutTopology& topology,
+                                  const PeriodJumpSource& period_jumps = {});
   const CrossField& field() const { return field_; }
   //! Gives every factorization shared with another copy of this solver its own CHOLMOD factor
   //! (numeric values included): the copies can then be solved on different threads.
@@ -191,7 +197,8 @@ class CrossFieldSolver {
   //! (analysis reused on the same pattern), warm start, solve and drop passes.
   void setup(const TriMesh& mesh, const GeometryCache& geometry, const Layout& layout,
              const LayoutTopology& topology, FieldConstraints constraints, int tolerated = 0,
-             const ReferenceRotation& reference_rotation = {});
+             const ReferenceRotation& reference_rotation = {},
+             const PeriodJumpSource& period_jumps = {});
   Eigen::VectorXd rhs(const GeometryCache& geometry, const std::vector<double>& c) const;
   std::vector<double> constraint_angles(const GeometryCache& geometry) const;
   void factorize(SpdSolver& solver, const Eigen::SparseMatrix<double>& A);  //!< timed, counted

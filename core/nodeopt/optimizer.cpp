@@ -703,8 +703,9 @@ struct NodeOptimizer::Impl {
       for (const auto& n : state.layout.nodes) all_vertices.push_back(n.vertex);
       std::future<std::vector<int>> cells;
       if (options.param.second_thread)
-        cells = std::async(std::launch::async,
-                           [this, &all_vertices] { return node_voronoi_cells(original, all_vertices); });
+        cells = std::async(std::launch::async, [this, &all_vertices] {
+          return node_voronoi_cells(original, all_vertices);
+        });
       // Gradients at the current solution (the future waits in its destructor if they throw).
       std::vector<int> vertices;
       for (int n : movable) vertices.push_back(state.layout.nodes[n].vertex);

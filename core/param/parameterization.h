@@ -110,9 +110,9 @@ class ParamSolver {
   //! \p theta gives the same feature-edge directions and arc labels up to a half turn (the rows
   //! see a label's parity only), so every constraint row is the same. It then takes \p theta's
   //! labeling (symbols and diagnostics for \p theta). False: the solver is unchanged and not
-  //! for this field. \p mesh, \p geometry, \p layout, \p topology: as at construction (same positions
-  //! not required: the rows are combinatorial).
-  //! \throw TopologyError as the constructor (labels).
+  //! for this field. \p mesh, \p geometry, \p layout, \p topology: as at construction (same
+  //! positions not required: the rows are combinatorial). \throw TopologyError as the constructor
+  //! (labels).
   bool adopt_field(const TriMesh& mesh, const GeometryCache& geometry, const Layout& layout,
                    const LayoutTopology& topology, const std::vector<int>& period_jump,
                    const std::vector<double>& theta);

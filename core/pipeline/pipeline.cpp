@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <future>
 #include <sstream>
+#include <utility>
 
 #include "core/base/atomic_file.h"
 #include "core/base/errors.h"
@@ -93,27 +94,48 @@ const CrossField& Pipeline::compute_field() {
     // only for the arc labels' global u/v choice and the feature edges' directions: it is
     // built on the second thread from the last field's θ while the field is solved, and
     // compute_parameterization() keeps it when the solved field gives the same rows
-    // (ParamSolver::adopt_field), else builds one as before. Joined before returning (also
-    // when update_layout throws: the future waits in its destructor), so it never outlives
-    // this call's use of the members.
+    // (ParamSolver::adopt_field), else builds one as before. That thread computes the period
+    // jumps first and hands them to update_layout too. Joined before returning (also when
+    // update_layout throws: the future waits in its destructor), so it never outlives this
+    // call's use of the members.
     prepared_param_.reset();
+    using Jumps = std::pair<std::vector<int>, PeriodJumpReport>;
+    std::promise<Jumps> jumps_promise;
+    std::shared_future<Jumps> jumps;
     std::future<std::unique_ptr<ParamSolver>> prepared;
-    if (options_.param.second_thread)
-      prepared = std::async(std::launch::async,
-                            [this, theta = field_solver_->field().theta]() {
-                              std::unique_ptr<ParamSolver> solver;
-                              try {
-                                const std::vector<int> p =
-                                    compute_period_jumps(mesh_, geometry_, layout_, topology_);
-                                solver = std::make_unique<ParamSolver>(
-                                    mesh_, geometry_, layout_, topology_, p, theta, options_.param,
-                                    nullptr, /*solve_now=*/false);
-                              } catch (const QsError&) {
-                                // compute_parameterization()'s own construction reports it
-                              }
-                              return solver;
-                            });
-    const CrossField& f = field_solver_->update_layout(mesh_, geometry_, layout_, topology_);
+    if (options_.param.second_thread) {
+      jumps = jumps_promise.get_future().share();
+      prepared = std::async(std::launch::async, [this, theta = field_solver_->field().theta,
+                                                 promise = std::move(jumps_promise)]() mutable {
+        std::unique_ptr<ParamSolver> solver;
+        std::vector<int> p;
+        try {
+          PeriodJumpReport report;
+          p = compute_period_jumps(mesh_, geometry_, layout_, topology_, &report);
+          promise.set_value({p, report});
+        } catch (...) {
+          promise.set_exception(std::current_exception());  // update_layout throws it
+          return solver;
+        }
+        try {
+          solver = std::make_unique<ParamSolver>(mesh_, geometry_, layout_, topology_, p, theta,
+                                                 options_.param, nullptr,
+                                                 /*solve_now=*/false);
+        } catch (const QsError&) {
+          // compute_parameterization()'s own construction reports it
+        }
+        return solver;
+      });
+    }
+    CrossFieldSolver::PeriodJumpSource period_jumps;
+    if (jumps.valid())
+      period_jumps = [&jumps](PeriodJumpReport* report) {
+        const Jumps& j = jumps.get();
+        if (report) *report = j.second;
+        return j.first;
+      };
+    const CrossField& f =
+        field_solver_->update_layout(mesh_, geometry_, layout_, topology_, period_jumps);
     field_layout_stale_ = false;
     if (prepared.valid()) prepared_param_ = prepared.get();
     return f;
@@ -143,8 +165,8 @@ const Parameterization& Pipeline::compute_parameterization() {
     // solver's first solve waits until it is chosen.
     const bool free_rotation = field.gauge_face >= 0;
     std::unique_ptr<ParamSolver> prepared = std::move(prepared_param_);
-    if (prepared && prepared->adopt_field(mesh_, geometry_, layout_, topology_,
-                                          field.period_jump, field.theta)) {
+    if (prepared && prepared->adopt_field(mesh_, geometry_, layout_, topology_, field.period_jump,
+                                          field.theta)) {
       param_solver_ = std::move(prepared);  // not solved yet: the solve below
       param_prepared_ = true;
     } else {
