@@ -318,7 +318,8 @@ TEST(ReuseParam, AdoptsASolverSetUpForAnotherFieldOnlyWithTheSameRows) {
 TEST(ReuseParam, PreparedSolversGiveTheSameParameterization) {
   const auto cs = test::cube_sphere(8, Vec3(2.0, 1.0, 0.6));
   const Example ex{cs.mesh, cs.layout};
-  const PipelineOptions options;
+  PipelineOptions options;
+  options.prepare_param_min_faces = 0;  // a small mesh
   ASSERT_GT(options.field.max_cluster_faces, 0) << "split clusters: the reference rotation";
   Pipeline first(ex.mesh, ex.layout, options);
   first.compute_field();
@@ -353,6 +354,14 @@ TEST(ReuseParam, PreparedSolversGiveTheSameParameterization) {
               continued.param_solver()->labeling().geometric_mismatches);
   }
   EXPECT_GT(adopted, 0) << "no continued pipeline adopted its prepared solver";
+  // With the default threshold a mesh this small sets the solver up after the field.
+  const PipelineOptions defaults;
+  ASSERT_LT(static_cast<int>(ex.mesh.n_faces()), defaults.prepare_param_min_faces);
+  Pipeline first_default(ex.mesh, ex.layout, defaults);
+  first_default.compute_parameterization();
+  Pipeline later(ex.mesh, moved_layout(ex.mesh, ex.layout, 1), first_default);
+  later.compute_parameterization();
+  EXPECT_FALSE(later.param_solver_prepared());
 }
 
 }  // namespace

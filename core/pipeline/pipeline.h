@@ -21,6 +21,12 @@ namespace qs {
 struct PipelineOptions {
   CrossFieldOptions field;
   ParamOptions param;
+  //! Continued pipelines (Pipeline(mesh, layout, previous)) with at least this many faces set
+  //! up the parameterization solver on a second thread while the field is solved (with
+  //! ParamOptions::second_thread). Smaller meshes set it up after the field: a thread per
+  //! re-layout costs more than it overlaps there (the 1728-face ellipsoid's node optimization
+  //! took 13 % more CPU time with it).
+  int prepare_param_min_faces = 10000;
 };
 
 //! A singular vertex of the cross field.
