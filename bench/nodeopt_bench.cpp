@@ -138,11 +138,12 @@ int main(int argc, char** argv) {
       std::printf(
           "repeat %d: fresh pipeline %.3f s, param re-solve %.3f s, median step %.3f s "
           "(%.1fx), optimize %.3f s CPU (%.3f s wall), steps %d (accepted %d), E %.6g -> %.6g, "
-          "fresh pipelines %d, relayouts %d (%d beside their retry), reused solves %d, "
-          "gradient reuses %d, tabu steps %d\n",
+          "fresh pipelines %d, relayouts %d (%d beside their retry, %d with the parameterization "
+          "set up beside the field), reused solves %d, gradient reuses %d, tabu steps %d\n",
           rep, fresh.back(), resolve.back(), step.back(), ratio.back(), total.back(), wall, r.steps,
           r.accepted, r.E_init, r.E_final, stats.fresh_pipelines, stats.relayouts,
-          stats.parallel_retries, stats.reused_solves, stats.gradient_reuses, stats.tabu_steps);
+          stats.parallel_retries, stats.prepared_param_solvers, stats.reused_solves,
+          stats.gradient_reuses, stats.tabu_steps);
     }
     std::printf(
         "median: faces %zu, nodes %zu, fresh pipeline %.3f s, param re-solve %.3f s, median "

@@ -419,6 +419,7 @@ struct NodeOptimizer::Impl {
     Evaluation ev;
     ev.pipeline = switched_pipeline(m, l, false);
     solve_and_measure(ev, options);
+    counters.prepared_param_solvers += ev.pipeline->param_solver_prepared();
     return ev;
   }
 

@@ -227,8 +227,11 @@ struct NodeOptResult {
 
 //! Counters of the work done by optimize_nodes (for benchmarks and the reuse test).
 struct NodeOptStats {
-  int fresh_pipelines = 0;     //!< Pipelines built from scratch (the start, reuse_field off)
-  int relayouts = 0;           //!< Pipelines continued from the current one (a node switched)
+  int fresh_pipelines = 0;  //!< Pipelines built from scratch (the start, reuse_field off)
+  int relayouts = 0;        //!< Pipelines continued from the current one (a node switched)
+  //! Re-layouts solved on this thread whose parameterization solver was set up beside the
+  //! field and kept (Pipeline::param_solver_prepared)
+  int prepared_param_solvers = 0;
   int reused_solves = 0;       //!< re-solves of the previous Pipeline after vertices moved
   int gradient_reuses = 0;     //!< steps after a rejection that reused the gradient
   int tabu_steps = 0;          //!< trials rejected as repeated switches (switch_tabu)
