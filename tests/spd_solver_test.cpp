@@ -93,6 +93,29 @@ TEST(SpdSolver, CopiedAnalysisGivesTheSameSolutionWithoutAnAnalysis) {
   EXPECT_LT(relative_residual(A, first.solve(b), b), 1e-10);
 }
 
+// A copy shares the factorization until it factorizes another matrix of the same pattern: it
+// then takes over the analysis only (no new analysis) and the original keeps its own factor.
+TEST(SpdSolver, SharedCopyFactorizesWithTheAnalysisOnly) {
+  const auto A = grid_matrix(25, 0.05);
+  const auto A2 = grid_matrix(25, 0.05, 3.0);
+  const Eigen::VectorXd b = random_vector(static_cast<int>(A.rows()), 5);
+  SpdSolver original("original"), reference("reference");
+  original.factorize(A);
+  const Eigen::VectorXd expected = original.solve(b);
+  SpdSolver copy = original;
+  const int analyses = copy.stats().analyses;
+  copy.factorize(A2);
+  EXPECT_EQ(copy.stats().analyses, analyses);
+  reference.factorize(A2);
+  const Eigen::VectorXd x = copy.solve(b);
+  EXPECT_EQ(x, reference.solve(b));  // same ordering and supernodes: the same factor
+  EXPECT_LT(relative_residual(A2, x, b), 1e-10);
+  EXPECT_EQ(original.solve(b), expected);
+  // Again, now with its own factor: the values are replaced in place.
+  copy.factorize(A);
+  EXPECT_EQ(copy.solve(b), expected);
+}
+
 TEST(SpdSolver, CopyFromAnUnanalyzedSolverChangesNothing) {
   SpdSolver empty("empty"), target("target");
   EXPECT_FALSE(target.copy_analysis_from(empty));

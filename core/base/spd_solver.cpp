@@ -24,25 +24,68 @@ class SupernodalLlt
   // Failures are reported as SolverError by SpdSolver; CHOLMOD's own console messages off.
   SupernodalLlt() { cholmod().print = 0; }
 
-  //! \return false when \p from has no analysis or CHOLMOD could not copy it.
+  //! Takes over \p from's symbolic analysis (its numeric values are not copied: the next
+  //! factorization computes them). \return false when \p from has no analysis or CHOLMOD could
+  //! not copy it.
   bool copy_analysis_from(SupernodalLlt& from) {
     if (!from.m_analysisIsOk || from.m_cholmodFactor == nullptr) return false;
-    cholmod_factor* copy = cholmod_copy_factor(from.m_cholmodFactor, &cholmod());
+    cholmod_factor* copy = copy_symbolic(from.m_cholmodFactor, &cholmod());
+    if (copy == nullptr) copy = cholmod_copy_factor(from.m_cholmodFactor, &cholmod());
     if (copy == nullptr) return false;
-    if (m_cholmodFactor != nullptr) cholmod_free_factor(&m_cholmodFactor, &cholmod());
-    m_cholmodFactor = copy;
-    m_isInitialized = true;
-    m_info = Eigen::Success;
-    m_analysisIsOk = true;
-    m_factorizationIsOk = false;
+    adopt(copy);
     return true;
   }
   //! Copy of \p from's whole factor (symbolic and numeric) and its factorized state.
   bool copy_factor_from(SupernodalLlt& from) {
-    if (!copy_analysis_from(from)) return false;
+    if (!from.m_analysisIsOk || from.m_cholmodFactor == nullptr) return false;
+    cholmod_factor* copy = cholmod_copy_factor(from.m_cholmodFactor, &cholmod());
+    if (copy == nullptr) return false;
+    adopt(copy);
     m_factorizationIsOk = from.m_factorizationIsOk;
     m_info = from.m_info;
     return true;
+  }
+  //! A symbolic supernodal factor with \p from's ordering and supernodal structure, as
+  //! cholmod_analyze returns it, without \p from's numeric values (cholmod_copy_factor copies
+  //! those too: on the 70K bunny's field a copy per factorization of a shared solver moved
+  //! 12 MB). nullptr when \p from is not supernodal or memory runs out.
+  static cholmod_factor* copy_symbolic(const cholmod_factor* from, cholmod_common* c) {
+    if (!from->is_super || from->super == nullptr) return nullptr;
+    const size_t n = from->n;
+    cholmod_factor* f = cholmod_allocate_factor(n, c);
+    if (f == nullptr) return nullptr;
+    std::copy_n(static_cast<const int*>(from->Perm), n, static_cast<int*>(f->Perm));
+    std::copy_n(static_cast<const int*>(from->ColCount), n, static_cast<int*>(f->ColCount));
+    f->ordering = from->ordering;
+    f->is_ll = from->is_ll;
+    f->xsize = from->xsize;
+    f->ssize = from->ssize;
+    f->nsuper = from->nsuper;
+    // Allocates super, pi, px (nsuper + 1 each) and s (ssize) of a symbolic supernodal factor.
+    if (!cholmod_change_factor(CHOLMOD_PATTERN, /*to_ll=*/true, /*to_super=*/true,
+                               /*to_packed=*/true, /*to_monotonic=*/true, f, c)) {
+      cholmod_free_factor(&f, c);
+      return nullptr;
+    }
+    const size_t ns = from->nsuper + 1;
+    std::copy_n(static_cast<const int*>(from->super), ns, static_cast<int*>(f->super));
+    std::copy_n(static_cast<const int*>(from->pi), ns, static_cast<int*>(f->pi));
+    std::copy_n(static_cast<const int*>(from->px), ns, static_cast<int*>(f->px));
+    std::copy_n(static_cast<const int*>(from->s), from->ssize, static_cast<int*>(f->s));
+    f->maxcsize = from->maxcsize;
+    f->maxesize = from->maxesize;
+    f->minor = n;
+    f->is_monotonic = from->is_monotonic;
+    return f;
+  }
+  //! Makes \p factor (analysed, not factorized) this solver's.
+  void adopt(cholmod_factor* factor) {
+    if (m_cholmodFactor != nullptr) cholmod_free_factor(&m_cholmodFactor, &cholmod());
+    m_cholmodFactor = factor;
+    m_isInitialized = true;
+    m_info = Eigen::Success;
+    m_analysisIsOk = true;
+    m_factorizationIsOk = false;
   }
   //! The view of \p A that CHOLMOD reads: its upper triangle (stype 1) when \p upper, else its
   //! lower triangle (stype −1).
