@@ -54,8 +54,9 @@ class Pipeline {
   //!   needs one or the constraint set changed (then one numeric factorization with the kept
   //!   analysis). θ equals a fresh Pipeline's up to solver round-off.
   //! The parameterization solver is built anew: its combinatorial setup and symbolic analysis
-  //! on the second thread while the field is re-solved (ParamOptions::second_thread), kept when
-  //! the new field gives the same constraint rows. Without a field in \p previous the field is
+  //! on the second thread while the field is re-solved (ParamOptions::second_thread, meshes of
+  //! at least PipelineOptions::prepare_param_min_faces faces), kept when the new field gives the
+  //! same constraint rows. Without a field in \p previous the field is
   //! built as in a fresh Pipeline. \p previous is not changed.
   //! \throw InvalidInputError when the vertex or face count differs.
   Pipeline(TriMesh mesh, Layout layout, const Pipeline& previous);
@@ -115,8 +116,9 @@ class Pipeline {
   //! A field solved for this pipeline's layout exists (not a copy awaiting update_layout).
   bool field_current() const { return field_solver_ && !field_layout_stale_; }
   std::unique_ptr<ParamSolver> param_solver_;
-  //! Continued pipelines: the parameterization solver set up beside update_layout from the
-  //! previous field (compute_field), until compute_parameterization adopts or drops it.
+  //! The parameterization solver set up ahead by compute_field (a fresh field: the reference
+  //! rotation's; a continued one: the one set up beside update_layout from the previous field),
+  //! until compute_parameterization adopts or drops it.
   std::unique_ptr<ParamSolver> prepared_param_;
   bool param_prepared_ = false;  //!< param_solver_ was prepared_param_ (param_solver_prepared)
   std::unique_ptr<Extraction> extraction_;
