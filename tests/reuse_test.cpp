@@ -319,7 +319,7 @@ TEST(ReuseParam, PreparedSolversGiveTheSameParameterization) {
   const auto cs = test::cube_sphere(8, Vec3(2.0, 1.0, 0.6));
   const Example ex{cs.mesh, cs.layout};
   PipelineOptions options;
-  options.prepare_param_min_faces = 0;  // a small mesh
+  options.second_thread_min_faces = 0;  // a small mesh
   ASSERT_GT(options.field.max_cluster_faces, 0) << "split clusters: the reference rotation";
   Pipeline first(ex.mesh, ex.layout, options);
   first.compute_field();
@@ -356,7 +356,7 @@ TEST(ReuseParam, PreparedSolversGiveTheSameParameterization) {
   EXPECT_GT(adopted, 0) << "no continued pipeline adopted its prepared solver";
   // With the default threshold a mesh this small sets the solver up after the field.
   const PipelineOptions defaults;
-  ASSERT_LT(static_cast<int>(ex.mesh.n_faces()), defaults.prepare_param_min_faces);
+  ASSERT_LT(static_cast<int>(ex.mesh.n_faces()), defaults.second_thread_min_faces);
   Pipeline first_default(ex.mesh, ex.layout, defaults);
   first_default.compute_parameterization();
   Pipeline later(ex.mesh, moved_layout(ex.mesh, ex.layout, 1), first_default);

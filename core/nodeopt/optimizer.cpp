@@ -700,12 +700,12 @@ struct NodeOptimizer::Impl {
     if (state_changed) {
       // Node-Voronoi cells on the original mesh, from all node vertices: on the second thread
       // while the gradients are computed (they only read the original mesh and the node list),
-      // on meshes large enough for a thread to pay (PipelineOptions::prepare_param_min_faces).
+      // on meshes large enough for a thread to pay (PipelineOptions::second_thread_min_faces).
       std::vector<int> all_vertices;
       for (const auto& n : state.layout.nodes) all_vertices.push_back(n.vertex);
       std::future<std::vector<int>> cells;
       if (options.param.second_thread &&
-          static_cast<int>(original.n_faces()) >= options.prepare_param_min_faces)
+          static_cast<int>(original.n_faces()) >= options.second_thread_min_faces)
         cells = std::async(std::launch::async, [this, &all_vertices] {
           return node_voronoi_cells(original, all_vertices);
         });

@@ -340,17 +340,14 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
   }
   // Explicit feature edges (layout "features") that are not arcs: iso-lines of the field's
   // matching parameter.
-  feature_directions_ = feature_edge_directions(mesh, g, layout, theta);
+  feature_rows_ = feature_edge_rows(mesh, g, layout, theta);
   for (size_t i = 0; i < layout.feature_edges.size(); ++i) {
-    if (feature_directions_[i] < 0) continue;
+    const FeatureRow& row = feature_rows_[i];
+    if (row.face < 0) continue;
     const auto [a, b] = layout.feature_edges[i];
-    auto h = mesh.find_halfedge(mesh.vertex_handle(a), mesh.vertex_handle(b));
-    if (mesh.is_boundary(h)) h = mesh.opposite_halfedge_handle(h);
-    const int f = mesh.face_handle(h).idx();
-    const bool along_u = feature_directions_[i] == 1;
-    const Lin2 d = sub(corner_expr(g, cut_, f, b), corner_expr(g, cut_, f, a));
+    const Lin2 d = sub(corner_expr(g, cut_, row.face, b), corner_expr(g, cut_, row.face, a));
     const int o = system_.add_origin("feature edge " + edge_name(a, b));
-    add_row(along_u ? d.v : d.u, 0.0, o);
+    add_row(row.along_u ? d.v : d.u, 0.0, o);
   }
   reduction_ = eliminate_constraints(system_);
   assembly_ = ReducedAssembly(cut_.corner_wedge, cut_.wedges, system_.variables, reduction_.Z);
@@ -378,11 +375,10 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
 
 ParamSolver::~ParamSolver() = default;
 
-std::vector<signed char> ParamSolver::feature_edge_directions(const TriMesh& mesh,
-                                                              const GeometryCache& g,
-                                                              const Layout& layout,
-                                                              const std::vector<double>& theta) {
-  std::vector<signed char> out(layout.feature_edges.size(), -1);
+std::vector<ParamSolver::FeatureRow> ParamSolver::feature_edge_rows(
+    const TriMesh& mesh, const GeometryCache& g, const Layout& layout,
+    const std::vector<double>& theta) {
+  std::vector<FeatureRow> out(layout.feature_edges.size());
   if (out.empty()) return out;
   const std::vector<char> arc_edge = arc_edge_mask(mesh, layout);
   for (size_t i = 0; i < out.size(); ++i) {
@@ -393,7 +389,7 @@ std::vector<signed char> ParamSolver::feature_edge_directions(const TriMesh& mes
     const int f = mesh.face_handle(h).idx();
     const Vec3 t = mesh.point(mesh.vertex_handle(b)) - mesh.point(mesh.vertex_handle(a));
     const double rel = g.angle_in_face(f, t) - theta[f];
-    out[i] = std::lround(rel / (M_PI / 2)) % 2 == 0 ? 1 : 0;
+    out[i] = {f, std::lround(rel / (M_PI / 2)) % 2 == 0};
   }
   return out;
 }
@@ -401,8 +397,7 @@ std::vector<signed char> ParamSolver::feature_edge_directions(const TriMesh& mes
 bool ParamSolver::adopt_field(const TriMesh& mesh, const GeometryCache& g, const Layout& layout,
                               const LayoutTopology& topology, const std::vector<int>& p,
                               const std::vector<double>& theta) {
-  if (p != period_jump_ || feature_edge_directions(mesh, g, layout, theta) != feature_directions_)
-    return false;
+  if (p != period_jump_ || feature_edge_rows(mesh, g, layout, theta) != feature_rows_) return false;
   Labeling labels = label_layout(mesh, g, layout, topology, p, theta);
   // The rows see a symbol's parity only (which parameter is constant along the arc): symbols
   // that all differ by a half turn give the same system.

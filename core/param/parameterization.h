@@ -167,13 +167,20 @@ class ParamSolver {
     double constant = 0;
   };
   std::vector<ArcSpan> arc_spans_;
-  //! Per Layout::feature_edges entry: 1 iso-line of v (along u), 0 of u, -1 no row (an arc edge
-  //! or not a mesh edge). From the field's θ at construction.
-  std::vector<signed char> feature_directions_;
-  static std::vector<signed char> feature_edge_directions(const TriMesh& mesh,
-                                                          const GeometryCache& geometry,
-                                                          const Layout& layout,
-                                                          const std::vector<double>& theta);
+  //! The iso-line row of one Layout::feature_edges entry: the face whose chart it is written in
+  //! (-1: no row, an arc edge or not a mesh edge) and whether it runs along u (v constant).
+  struct FeatureRow {
+    int face = -1;
+    bool along_u = false;
+    bool operator==(const FeatureRow& o) const { return face == o.face && along_u == o.along_u; }
+    bool operator!=(const FeatureRow& o) const { return !(*this == o); }
+  };
+  //! Per Layout::feature_edges entry, from the field's θ at construction.
+  std::vector<FeatureRow> feature_rows_;
+  static std::vector<FeatureRow> feature_edge_rows(const TriMesh& mesh,
+                                                   const GeometryCache& geometry,
+                                                   const Layout& layout,
+                                                   const std::vector<double>& theta);
   //! With ParamOptions::wedge_ordering, hands the wedge-graph ordering of \p A to the linear
   //! solver when its next factorization analyzes (A's pattern is not the analyzed one).
   void hint_ordering(const Eigen::SparseMatrix<double>& A);

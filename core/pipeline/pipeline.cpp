@@ -103,7 +103,7 @@ const CrossField& Pipeline::compute_field() {
     std::promise<Jumps> jumps_promise;
     std::shared_future<Jumps> jumps;
     std::future<std::unique_ptr<ParamSolver>> prepared;
-    if (options_.param.second_thread && geometry_.n_faces >= options_.prepare_param_min_faces) {
+    if (options_.param.second_thread && geometry_.n_faces >= options_.second_thread_min_faces) {
       jumps = jumps_promise.get_future().share();
       prepared = std::async(std::launch::async, [this, theta = field_solver_->field().theta,
                                                  promise = std::move(jumps_promise)]() mutable {

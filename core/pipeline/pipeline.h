@@ -21,12 +21,13 @@ namespace qs {
 struct PipelineOptions {
   CrossFieldOptions field;
   ParamOptions param;
-  //! Continued pipelines (Pipeline(mesh, layout, previous)) with at least this many faces set
-  //! up the parameterization solver on a second thread while the field is solved (with
-  //! ParamOptions::second_thread). Smaller meshes set it up after the field: a thread per
-  //! re-layout costs more than it overlaps there (the 1728-face ellipsoid's node optimization
-  //! took 13 % more CPU time with it).
-  int prepare_param_min_faces = 10000;
+  //! With ParamOptions::second_thread, work that runs beside the main thread's only on meshes
+  //! of at least this many faces: a continued pipeline's parameterization set-up while the field
+  //! is solved (Pipeline(mesh, layout, previous)) and the node optimizer's Voronoi cells while
+  //! the gradients are computed. Smaller meshes do it in sequence: a thread per re-layout costs
+  //! more than it overlaps there (the 1728-face ellipsoid's node optimization took 13 % more CPU
+  //! time with it).
+  int second_thread_min_faces = 10000;
 };
 
 //! A singular vertex of the cross field.
@@ -55,7 +56,7 @@ class Pipeline {
   //!   analysis). θ equals a fresh Pipeline's up to solver round-off.
   //! The parameterization solver is built anew: its combinatorial setup and symbolic analysis
   //! on the second thread while the field is re-solved (ParamOptions::second_thread, meshes of
-  //! at least PipelineOptions::prepare_param_min_faces faces), kept when the new field gives the
+  //! at least PipelineOptions::second_thread_min_faces faces), kept when the new field gives the
   //! same constraint rows. Without a field in \p previous the field is
   //! built as in a fresh Pipeline. \p previous is not changed.
   //! \throw InvalidInputError when the vertex or face count differs.
