@@ -14,6 +14,8 @@
 #include "core/base/spd_solver.h"
 #include "tests/fixtures.h"
 
+extern "C" double SuiteSparse_time();  // core/base/solver_threads.cpp
+
 namespace qs {
 namespace {
 
@@ -108,6 +110,25 @@ TEST(SolverThreads, SerialRegionsRunInlineAndOthersReachLibgomp) {
     }
   }
   set_solver_threads(0);
+}
+
+// CHOLMOD's clock reads (SuiteSparse_time, around every dense BLAS call of its factorization)
+// bind to our definition, which reads no clock: the dynamic linker finds it before
+// libsuitesparseconfig's, which it shadows.
+TEST(SolverThreads, CholmodClockReadsBindToTheSilentDefinition) {
+  void* bound = dlsym(RTLD_DEFAULT, "SuiteSparse_time");
+  ASSERT_NE(bound, nullptr);
+  EXPECT_EQ(bound, reinterpret_cast<void*>(&SuiteSparse_time))
+      << "CHOLMOD would call libsuitesparseconfig's clock";
+  EXPECT_NE(dlsym(RTLD_NEXT, "SuiteSparse_time"), nullptr) << "nothing to shadow";
+  EXPECT_EQ(SuiteSparse_time(), 0.0);
+  // The factorization still works without its statistics' clock.
+  const Eigen::SparseMatrix<double> A = grid_matrix(60);
+  const Eigen::VectorXd x_true = Eigen::VectorXd::LinSpaced(A.rows(), -1.0, 2.0);
+  const Eigen::VectorXd b = A * x_true;
+  SpdSolver solver("clock test");
+  solver.factorize(A);
+  EXPECT_LT((solver.solve(b) - x_true).norm() / x_true.norm(), 1e-10);
 }
 
 // --threads is checked and applied (it used to be accepted and ignored).
