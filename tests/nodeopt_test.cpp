@@ -784,6 +784,47 @@ TEST(DiscreteRelocation, ParallelCandidatesGiveTheSequentialResult) {
   expect_same_layout(a.layout, b.layout);
 }
 
+// DiscreteOptions::stop ends the run inside a sweep with the moves made so far (the benchmark's
+// time cap), and on_move reports every kept move: falling E values, the last one the result's.
+TEST(DiscreteRelocation, StopEndsTheRunWithTheMovesMadeSoFar) {
+  const auto in = test::cube_sphere(6, Vec3(1.3, 1, 0.75));
+  const Layout start = test::displace_nodes(in.mesh, in.layout, 2, 5);
+  DiscreteOptions full;
+  full.max_steps = 3;
+  full.parallel = false;
+  std::vector<double> moves;
+  full.on_move = [&](double E) { moves.push_back(E); };
+  const NodeOptResult a = relocate_nodes_discrete(in.mesh, start, PipelineOptions{}, full);
+  ASSERT_GE(moves.size(), 2u) << "the case needs two moves for a stop between them";
+  EXPECT_LT(moves.front(), a.E_init);
+  for (size_t k = 1; k < moves.size(); ++k) EXPECT_LT(moves[k], moves[k - 1]);
+  EXPECT_DOUBLE_EQ(moves.back(), a.E_final);
+
+  // Stop right after the first move: no candidate is solved after it.
+  DiscreteOptions capped = full;
+  std::vector<double> capped_moves;
+  capped.on_move = [&](double E) { capped_moves.push_back(E); };
+  int polls_after_move = 0;
+  capped.stop = [&]() { return !capped_moves.empty() && ++polls_after_move > 0; };
+  Recorder rec;
+  const NodeOptResult b = relocate_nodes_discrete(in.mesh, start, PipelineOptions{}, capped, &rec);
+  ASSERT_EQ(capped_moves.size(), 1u);
+  EXPECT_EQ(polls_after_move, 1);
+  EXPECT_DOUBLE_EQ(capped_moves[0], moves[0]) << "same first move as the whole run";
+  EXPECT_DOUBLE_EQ(b.E_final, moves[0]);
+  EXPECT_GT(b.E_final, a.E_final);
+  ASSERT_EQ(rec.steps.size(), 1u) << "the stopped sweep is reported, no further sweep runs";
+  EXPECT_DOUBLE_EQ(rec.steps[0].E, b.E_final);
+  EXPECT_EQ(rec.steps[0].moved_nodes, 1);
+  EXPECT_TRUE(validate_layout(b.mesh, b.layout).valid());
+  // The result is the state it reports: solving it again gives its E.
+  Pipeline check(b.mesh, b.layout, PipelineOptions{});
+  check.compute_field();
+  const Parameterization& par = check.compute_parameterization();
+  EXPECT_NEAR(unweighted_energy(check.mesh(), check.geometry(), check.field()->theta, par,
+                                PipelineOptions{}.param),
+              b.E_final, 1e-9 * b.E_final);
+}
 // ---------------------------------------------------------------------------------------------
 // (f) reuse across steps (issue #5 speed): the shortcuts must not change results
 

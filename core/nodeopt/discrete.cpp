@@ -141,7 +141,13 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
     int best = -1;
     double best_E = result.E;
     for (size_t k = 0; k < list.size(); ++k) {
-      if (!list[k].solved) solve(k);
+      if (!list[k].solved) {
+        if (o.stop && o.stop()) {
+          result.stopped = true;
+          break;
+        }
+        solve(k);
+      }
       ++result.evaluations;
       if (list[k].ok && list[k].E < best_E) {
         best_E = list[k].E;
@@ -158,6 +164,7 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
       result.E = best_E;
       result.foldovers = list[best].foldovers;
       ++result.moved;
+      if (o.on_move) o.on_move(best_E);
     }
   };
   for (size_t i = 0; i < nodes.size(); ++i) {
@@ -206,7 +213,7 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
       list.push_back(std::move(c));
     }
     if (!list.empty()) solve_candidates(list, v, restored);
-    if (result.evaluations >= o.max_evaluations) break;
+    if (result.stopped || result.evaluations >= o.max_evaluations) break;
     if (o.max_failures > 0 && failures >= o.max_failures) break;
   }
   return result;
@@ -254,6 +261,8 @@ NodeOptResult relocate_nodes_discrete(const TriMesh& mesh, const Layout& layout,
       d.parallel && std::thread::hardware_concurrency() >= 2 ? &make_job : nullptr;
   HopSweepOptions sweep;
   sweep.relocation = d.relocation;
+  sweep.stop = d.stop;
+  sweep.on_move = d.on_move;
   int evaluations = 0;
   for (int step = 1; step <= d.max_steps && evaluations < d.max_evaluations; ++step) {
     const auto t_step = std::chrono::steady_clock::now();
@@ -279,8 +288,8 @@ NodeOptResult relocate_nodes_discrete(const TriMesh& mesh, const Layout& layout,
     }
     result.reports.push_back(r);
     if (observer) observer->on_step(r);
-    if (s.moved == 0) break;
-    ++result.accepted;
+    if (s.moved > 0) ++result.accepted;
+    if (s.moved == 0 || s.stopped) break;
   }
   result.E_descent = result.E_final = E;
   result.foldovers_descent = result.foldovers_final = foldovers;

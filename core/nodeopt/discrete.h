@@ -23,12 +23,20 @@ struct DiscreteOptions {
   //! A node's candidates are solved two at a time (hop_sweep's jobs) when the machine
   //! reports two hardware threads; same result as one at a time.
   bool parallel = true;
+  //! Ends the run early when it returns true (checked before each candidate solve), keeping the
+  //! moves made so far: a time cap, as in the paper's comparison (§6.3: "after max 1h"). The
+  //! sweep it ends is reported like any other. Empty: no early end.
+  std::function<bool()> stop;
+  //! Called after each node move the run keeps, with the new E (length²): the trajectory within
+  //! a sweep, whose report comes only at its end. Empty: not called.
+  std::function<void(double E)> on_move;
 };
 
 //! Runs the discrete baseline on the original mesh positions (no vertex relocation). Nodes move
 //! one at a time (Gauss–Seidel): a node's best neighbour is accepted at once when it lowers E.
-//! Stops when a sweep improves nothing, or at max_steps / max_evaluations. One StepReport per
-//! sweep. \throw InvalidInputError, TopologyError, SolverError, Cancelled.
+//! Stops when a sweep improves nothing, at max_steps / max_evaluations, or when
+//! DiscreteOptions::stop says so. One StepReport per sweep. \throw InvalidInputError,
+//! TopologyError, SolverError, Cancelled.
 NodeOptResult relocate_nodes_discrete(const TriMesh& mesh, const Layout& layout,
                                       const PipelineOptions& options,
                                       const DiscreteOptions& discrete = {},
@@ -72,13 +80,19 @@ struct HopSweepOptions {
   //! The sweep stops after this many candidate solves in a row that found no lower E
   //! (≤ 0: no limit); with the most promising nodes first, the rest rarely pays.
   int max_failures = 0;
+  //! Ends the sweep when it returns true (checked before each candidate solve); the best
+  //! candidate of the node in progress among those solved is still taken. Empty: never.
+  std::function<bool()> stop;
+  //! Called after each node move the sweep keeps, with the new E. Empty: not called.
+  std::function<void(double E)> on_move;
 };
 
 struct HopSweepResult {
-  int moved = 0;        //!< nodes that hopped
-  int evaluations = 0;  //!< candidate solves
-  double E = 0;         //!< residual of the final state
-  int foldovers = 0;    //!< fold-overs of the final state
+  int moved = 0;         //!< nodes that hopped
+  int evaluations = 0;   //!< candidate solves
+  bool stopped = false;  //!< HopSweepOptions::stop ended the sweep
+  double E = 0;          //!< residual of the final state
+  int foldovers = 0;     //!< fold-overs of the final state
 };
 
 //! Angle deficit 2π − Σ angles at every vertex (GeometryCache::angle_defect; radians), 0 at
