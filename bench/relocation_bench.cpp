@@ -14,6 +14,8 @@
 // paper's comparison capped it at 1 h). The ratio is then a lower bound (printed with ≥): the
 // whole discrete run would take longer. Also printed: the CPU time at which the discrete run
 // first reaches the continuous run's final E (its trajectory move by move), or "not within".
+// The continuous column also gives its fold-overs at the end and E / fold-overs before the
+// fold-over removal (orientation constraints, which can raise E); the discrete run removes none.
 // --hop-all: the continuous run's hop polish tries every neighbour of every relocated node (no
 // offset, direction or work limit), an experiment against the defaults.
 // --no-discrete: only the continuous run (E, CPU time, hop sweeps, hops, steps, fold-overs).
@@ -315,10 +317,13 @@ int main(int argc, char** argv) {
         const qs::NodeOptResult rx = qs::relocate_nodes_discrete(c.mesh, start, options, d);
         const double t_disc = cpu_now() - t0;
         const double reach = cont.time_to(rx.E_final, 1e-12 * rc.E_init);
-        std::printf("%s | %zu | %zu | %d | %.6g | %.6g (%.2f) | %.6g (%.2f) | %.6g (%.2f, %d%s) | ",
-                    c.name.c_str(), static_cast<size_t>(c.mesh.n_faces()), c.layout.nodes.size(),
-                    k > 0 ? seed : 0, rc.E_init, rc.E_final, t_cont, rd.E_final, t_desc, rx.E_final,
-                    t_disc, rx.steps, capped ? ", capped" : "");
+        std::printf(
+            "%s | %zu | %zu | %d | %.6g | %.6g (%.2f; %d folds, before removal %.6g / %d) | %.6g "
+            "(%.2f) | %.6g (%.2f, %d%s; %d folds) | ",
+            c.name.c_str(), static_cast<size_t>(c.mesh.n_faces()), c.layout.nodes.size(),
+            k > 0 ? seed : 0, rc.E_init, rc.E_final, t_cont, rc.foldovers_final, rc.E_descent,
+            rc.foldovers_descent, rd.E_final, t_desc, rx.E_final, t_disc, rx.steps,
+            capped ? ", capped" : "", rx.foldovers_final);
         if (reach >= 0)
           std::printf("%.2f | %s%.1f", reach, capped ? "≥ " : "", t_disc / std::max(reach, 1e-9));
         else
