@@ -765,13 +765,25 @@ TEST(DiscreteRelocation, LowersEnergy) {
   for (const auto& s : rec.steps) EXPECT_LE(s.E, r.E_init * (1 + 1e-12));
 }
 
+// The cube layout on an ellipsoid with its nodes displaced, and three sequential sweeps: the
+// case of the discrete baseline's option tests.
+struct DiscreteCase {
+  test::MeshAndLayout in = test::cube_sphere(6, Vec3(1.3, 1, 0.75));
+  Layout start = test::displace_nodes(in.mesh, in.layout, 2, 5);
+  DiscreteOptions sequential = [] {
+    DiscreteOptions d;
+    d.max_steps = 3;
+    d.parallel = false;
+    return d;
+  }();
+};
+
 // Two candidates at a time (DiscreteOptions::parallel): the same sweeps and the same result.
 TEST(DiscreteRelocation, ParallelCandidatesGiveTheSequentialResult) {
-  const auto in = test::cube_sphere(6, Vec3(1.3, 1, 0.75));
-  const Layout start = test::displace_nodes(in.mesh, in.layout, 2, 5);
-  DiscreteOptions sequential;
-  sequential.max_steps = 3;
-  sequential.parallel = false;
+  const DiscreteCase c;
+  const auto& in = c.in;
+  const Layout& start = c.start;
+  const DiscreteOptions& sequential = c.sequential;
   DiscreteOptions parallel = sequential;
   parallel.parallel = true;
   Recorder rec_a, rec_b;
@@ -787,11 +799,10 @@ TEST(DiscreteRelocation, ParallelCandidatesGiveTheSequentialResult) {
 // DiscreteOptions::stop ends the run inside a sweep with the moves made so far (the benchmark's
 // time cap), and on_move reports every kept move: falling E values, the last one the result's.
 TEST(DiscreteRelocation, StopEndsTheRunWithTheMovesMadeSoFar) {
-  const auto in = test::cube_sphere(6, Vec3(1.3, 1, 0.75));
-  const Layout start = test::displace_nodes(in.mesh, in.layout, 2, 5);
-  DiscreteOptions full;
-  full.max_steps = 3;
-  full.parallel = false;
+  const DiscreteCase c;
+  const auto& in = c.in;
+  const Layout& start = c.start;
+  DiscreteOptions full = c.sequential;
   std::vector<double> moves;
   full.on_move = [&](double E) { moves.push_back(E); };
   const NodeOptResult a = relocate_nodes_discrete(in.mesh, start, PipelineOptions{}, full);
