@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -452,6 +454,56 @@ TEST(OrientationRealData, FandiskInitialLayoutEndsWithoutFoldovers) {
   EXPECT_LE(r.E_final, r.E_descent * 1.05);
 }
 
+// Vertex rings (edge hops) from each vertex to the nearest vertex of \p sources.
+std::vector<int> rings_from(const TriMesh& mesh, const std::vector<int>& sources) {
+  std::vector<int> dist(mesh.n_vertices(), -1), queue;
+  for (int v : sources)
+    if (dist[v] < 0) dist[v] = 0, queue.push_back(v);
+  for (size_t head = 0; head < queue.size(); ++head) {
+    const int v = queue[head];
+    for (auto w : mesh.vv_range(mesh.vertex_handle(v)))
+      if (dist[w.idx()] < 0) dist[w.idx()] = dist[v] + 1, queue.push_back(w.idx());
+  }
+  return dist;
+}
+
+// The faces an infeasible orientation solve on the mask names are where the iso-lines wrap
+// around the free eye holes: each is nearer to an eye hole than to the outer boundary (in vertex
+// rings), and the message names it.
+void expect_named_faces_at_eye_holes(const TriMesh& mesh, const OrientationReport& report) {
+  const std::vector<int>& named = report.infeasible_faces;
+  ASSERT_FALSE(named.empty()) << report.message;
+  EXPECT_LE(named.size(), 5u);
+  std::vector<std::vector<int>> loops = boundary_loops(mesh);
+  ASSERT_EQ(loops.size(), 3u);
+  std::sort(loops.begin(), loops.end(),
+            [](const auto& x, const auto& y) { return x.size() > y.size(); });
+  std::vector<int> eyes = loops[1];
+  eyes.insert(eyes.end(), loops[2].begin(), loops[2].end());
+  const std::vector<int> to_eye = rings_from(mesh, eyes), to_outer = rings_from(mesh, loops[0]);
+  int nearer_eye = 0;  // of all faces, for scale
+  for (auto f : mesh.faces()) {
+    int eye = INT_MAX, outer = INT_MAX;
+    for (auto v : mesh.fv_range(f))
+      eye = std::min(eye, to_eye[v.idx()]), outer = std::min(outer, to_outer[v.idx()]);
+    nearer_eye += eye < outer;
+  }
+  std::printf("[stat] mask: %d of %zu faces are nearer to an eye hole than to the outer boundary\n",
+              nearer_eye, static_cast<size_t>(mesh.n_faces()));
+  for (int f : named) {
+    ASSERT_GE(f, 0);
+    ASSERT_LT(f, static_cast<int>(mesh.n_faces()));
+    int eye = INT_MAX, outer = INT_MAX;
+    for (auto v : mesh.fv_range(mesh.face_handle(f)))
+      eye = std::min(eye, to_eye[v.idx()]), outer = std::min(outer, to_outer[v.idx()]);
+    std::printf(
+        "[stat] mask: named face %d, %d rings from an eye hole, %d from the outer boundary\n", f,
+        eye, outer);
+    EXPECT_LT(eye, outer) << "face " << f;
+    EXPECT_NE(report.message.find(std::to_string(f)), std::string::npos) << report.message;
+  }
+}
+
 // mask_confmap.obj (three boundary loops) with one node and four dangling arcs to the eye
 // holes and the outer boundary (as in boundary_test): the fold-overs where the iso-lines wrap
 // around the free eye holes cannot be removed by the tri-sector constraints (the QP is
@@ -482,6 +534,7 @@ TEST(OrientationRealData, InfeasibleConstraintsOnMaskKeepTheSolveAndSayWhy) {
     EXPECT_NE(b.orientation.message.find("infeasible"), std::string::npos) << b.orientation.message;
     EXPECT_EQ(b.foldovers, a.foldovers);
     EXPECT_EQ(b.energy, a.energy);
+    expect_named_faces_at_eye_holes(mesh, b.orientation);
   }
 }
 
@@ -515,6 +568,8 @@ TEST(OrientationRealData, StopsWhenEveryFaceIsInfeasible) {
   EXPECT_NE(report[1].message.find("infeasible on every face"), std::string::npos)
       << report[1].message;
   EXPECT_LT(report[1].rounds, report[0].rounds);
+  // Every face constrained: the named faces could be anywhere on the mask.
+  expect_named_faces_at_eye_holes(mesh, report[1]);
   EXPECT_LE(report[1].foldovers_after, report[1].foldovers_before);
 }
 

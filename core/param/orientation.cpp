@@ -6,6 +6,9 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "core/base/errors.h"
 #include "core/base/spd_solver.h"
@@ -14,6 +17,8 @@
 namespace qs {
 
 namespace {
+
+constexpr int kNamedFaces = 5;  // faces an infeasible round names (OrientationReport)
 
 using Vec2 = Eigen::Vector2d;
 
@@ -55,7 +60,33 @@ struct ConstraintRows {
   Eigen::SparseMatrix<double> C;  // m × #y
   Eigen::VectorXd d;              // m
   int faces = 0, skipped = 0;
+  std::vector<int> face;  // #faces: the face of rows 6i … 6i + 5
 };
+
+// The constrained faces whose rows \p y violates most (by the scaled row value C y − d, most
+// negative first), at most \p count: where an infeasible QP's last iterate stays folded.
+std::vector<int> most_violated_faces(const ConstraintRows& rows, const Eigen::VectorXd& y,
+                                     int count) {
+  const Eigen::VectorXd r = rows.C * y - rows.d;
+  std::vector<std::pair<double, int>> worst;  // (most negative row value, face)
+  for (size_t i = 0; i < rows.face.size(); ++i) {
+    const double w = r.segment(6 * static_cast<Eigen::Index>(i), 6).minCoeff();
+    if (w < 0) worst.push_back({w, rows.face[i]});
+  }
+  const size_t n = std::min(worst.size(), static_cast<size_t>(std::max(count, 0)));
+  std::partial_sort(worst.begin(), worst.begin() + n, worst.end());
+  std::vector<int> out;
+  for (size_t i = 0; i < n; ++i) out.push_back(worst[i].second);
+  return out;
+}
+
+// ", most violated at faces a, b, c", or nothing without faces.
+std::string faces_clause(const std::vector<int>& faces) {
+  if (faces.empty()) return "";
+  std::string s = ", most violated at face" + std::string(faces.size() > 1 ? "s " : " ");
+  for (size_t i = 0; i < faces.size(); ++i) s += (i ? ", " : "") + std::to_string(faces[i]);
+  return s;
+}
 
 ConstraintRows build_rows(const TriMesh& mesh, const GeometryCache& g,
                           const std::vector<std::array<std::array<double, 2>, 3>>& ideal,
@@ -101,6 +132,7 @@ ConstraintRows build_rows(const TriMesh& mesh, const GeometryCache& g,
       m += 2;
     }
     ++out.faces;
+    out.face.push_back(f);
   }
   Eigen::SparseMatrix<double, Eigen::RowMajor> Cx(m, red.Z.rows());
   Cx.setFromTriplets(trip.begin(), trip.end());
@@ -509,6 +541,7 @@ Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& g,
     if (rows.C.rows() == 0) break;
     const bool dense = dense_for(static_cast<double>(rows.C.rows()));
     rep.dense = dense;
+    rep.infeasible_faces.clear();
     IpmOutcome ipm;
     if (dense) {
       // W = A⁻¹Cᵀ (m back-substitutions); for the scaled objective A/h: y = y0 + h·W·λ.
@@ -524,11 +557,13 @@ Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& g,
       rep.sparse_factorizations += ipm.iterations;
     }
     rep.iterations += ipm.iterations;
+    if (ipm.infeasible) rep.infeasible_faces = most_violated_faces(rows, y, kNamedFaces);
     if (ipm.infeasible && all_faces) {
       if (o.stop_if_all_faces_infeasible) {
         rep.message = "orientation constraints are infeasible on every face (round " +
-                      std::to_string(round + 1) + "); kept the best earlier solution (" +
-                      std::to_string(best_folds) + " fold-overs)";
+                      std::to_string(round + 1) + faces_clause(rep.infeasible_faces) +
+                      "); kept the best earlier solution (" + std::to_string(best_folds) +
+                      " fold-overs)";
         rep.all_faces = true;
         rep.foldovers_after = best_folds;
         rep.time_s = seconds_since(t0);
@@ -546,7 +581,7 @@ Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& g,
       std::ostringstream ss;
       ss << "orientation constraints are infeasible on " << rows.faces
          << " constrained faces (round " << round + 1 << ", primal residual " << ipm.primal_residual
-         << ")";
+         << faces_clause(rep.infeasible_faces) << ")";
       rep.message = ss.str();
       rep.time_s = seconds_since(t0);
       if (best_y.size() == 0) throw SolverError(rep.message);

@@ -112,6 +112,9 @@ struct OrientationReport {
   double energy_before = 0, energy_after = 0;  //!< value of the (weighted) energy (1)
   double time_s = 0;
   std::string message;  //!< why it failed, if it did
+  //! When the last round was infeasible: the constrained faces its last iterate violates most
+  //! (at most 5, worst first; also named in \ref message), where the layout cannot unfold.
+  std::vector<int> infeasible_faces;
 };
 
 //! Per-face ideal corner offsets Q_k (see above) in the field frame, [f][k] = (u, v), length
