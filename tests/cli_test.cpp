@@ -369,6 +369,49 @@ TEST(Cli, OrientationRemovesFoldoversWithoutNodeOptimization) {
   EXPECT_NE(out.find("contradict"), std::string::npos) << out;
 }
 
+// Where the orientation constraints are infeasible (mask_confmap.obj with a star of dangling
+// arcs to its free eye holes, as in orientation_test), the report lists the faces they violate
+// most and a warning names the layout node next to them.
+TEST(Cli, InfeasibleOrientationNamesTheNodesWhereTheLayoutFolds) {
+  const std::string dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
+  const std::string mesh_file = dir + "/mask_confmap.obj";
+  const TriMesh mesh = load_mesh(mesh_file);
+  const test::MaskStar star = test::mask_star(mesh);
+  ASSERT_EQ(star.boundary_loops, 3u);
+  const Layout layout = test::dangling_star_layout(mesh, star.center, star.targets);
+  const std::string out_dir = test::temp_dir("cli_infeasible_orientation");
+  const std::string layout_file = out_dir + "/star.layout.json";
+  save_layout(layout, layout_file, &mesh);
+  std::string out;
+  ASSERT_EQ(test::run_command(cli("optimize --no-node-opt --orientation --no-align --mesh " +
+                                  mesh_file + " --layout " + layout_file + " --out " + out_dir),
+                              &out),
+            0)
+      << out;
+  const auto report = read_json(out_dir + "/report.json");
+  const auto& orientation = report["fold_removal"]["orientation"];
+  ASSERT_TRUE(orientation["ran"].get<bool>());
+  ASSERT_FALSE(orientation["success"].get<bool>()) << "the case should stay infeasible";
+  const auto faces = orientation["infeasible_faces"].get<std::vector<int>>();
+  ASSERT_FALSE(faces.empty());
+  for (int f : faces) {
+    EXPECT_GE(f, 0);
+    EXPECT_LT(f, static_cast<int>(mesh.n_faces()));
+  }
+  const int left = report["metrics"]["foldovers"].get<int>();
+  ASSERT_GT(left, 0);
+  // The star's only node is its center.
+  const LayoutNode& center = layout.nodes.at(0);
+  ASSERT_EQ(center.vertex, star.center);
+  const std::string expected = "warning: " + std::to_string(left) +
+                               " fold-over(s) remain; the layout cannot be unfolded near node " +
+                               std::to_string(center.id) + " (vertex " +
+                               std::to_string(center.vertex) + ")";
+  EXPECT_NE(out.find(expected), std::string::npos) << out;
+  EXPECT_NE(out.find("most violated at face"), std::string::npos) << out;
+}
+
 // Sliding along the boundary from the command line: a boundary node of a flat grid layout two
 // edges off its place slides back by default (report: sliding_nodes), stays with --no-sliding;
 // --keep-sharp-edges is accepted (the flat grid has no sharp edges: the same result).
