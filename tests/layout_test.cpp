@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <climits>
 #include <set>
 
 #include "core/layout/validate.h"
@@ -40,6 +41,45 @@ TEST(LayoutTopology, CubeOnSphereHasSixQuadPatchesAndValence3Nodes) {
     EXPECT_EQ(p.faces, 72);
   }
   for (int v : topo.valence) EXPECT_EQ(v, 3);
+}
+
+// nodes_near_faces: each face's nearest node in vertex rings (a face at a node's vertex names
+// that node), without repeats, in the order of the faces; nothing beyond max_rings.
+TEST(LayoutNodes, NearestNodeOfFaces) {
+  auto [mesh, layout] = test::cube_sphere(6);
+  ASSERT_GE(layout.nodes.size(), 2u);
+  // Ring distances from every node vertex, and a face at each node's vertex.
+  auto face_at = [&](int v) { return (*mesh.vf_range(mesh.vertex_handle(v)).begin()).idx(); };
+  const int f0 = face_at(layout.nodes[0].vertex), f1 = face_at(layout.nodes[1].vertex);
+  EXPECT_EQ(nodes_near_faces(mesh, layout, {f1, f0, f1}), (std::vector<int>{1, 0}));
+  // Every face names the node of least ring distance from its vertices.
+  std::vector<std::vector<int>> rings;  // [node][vertex]
+  for (const LayoutNode& n : layout.nodes) {
+    std::vector<int> d(mesh.n_vertices(), -1), queue{n.vertex};
+    d[n.vertex] = 0;
+    for (size_t h = 0; h < queue.size(); ++h)
+      for (auto w : mesh.vv_range(mesh.vertex_handle(queue[h])))
+        if (d[w.idx()] < 0) d[w.idx()] = d[queue[h]] + 1, queue.push_back(w.idx());
+    rings.push_back(d);
+  }
+  int far_faces = 0;
+  for (auto fh : mesh.faces()) {
+    int best = INT_MAX;
+    std::vector<int> dist(layout.nodes.size(), INT_MAX);
+    for (size_t n = 0; n < layout.nodes.size(); ++n)
+      for (auto v : mesh.fv_range(fh)) dist[n] = std::min(dist[n], rings[n][v.idx()]);
+    for (int d : dist) best = std::min(best, d);
+    const std::vector<int> near = nodes_near_faces(mesh, layout, {fh.idx()});
+    ASSERT_EQ(near.size(), 1u) << "face " << fh.idx();
+    EXPECT_EQ(dist[near[0]], best) << "face " << fh.idx();
+    if (best > 1) {
+      ++far_faces;
+      EXPECT_TRUE(nodes_near_faces(mesh, layout, {fh.idx()}, best - 1).empty());
+      EXPECT_EQ(nodes_near_faces(mesh, layout, {fh.idx()}, best).size(), 1u);
+    }
+  }
+  EXPECT_GT(far_faces, 0);
+  EXPECT_TRUE(nodes_near_faces(mesh, layout, {-1, static_cast<int>(mesh.n_faces())}).empty());
 }
 
 TEST(LayoutTopology, PatchBordersAreOrbitsOfPhi) {

@@ -56,37 +56,6 @@ nlohmann::json orientation_json(const OrientationReport& r) {
           {"infeasible_faces", r.infeasible_faces}};
 }
 
-// Per face of \p faces, the layout node nearest to it in vertex rings of \p mesh (at most
-// kNearRings away), without repeats, in the order of the faces: indices into layout.nodes.
-std::vector<int> nodes_near_faces(const TriMesh& mesh, const Layout& layout,
-                                  const std::vector<int>& faces) {
-  constexpr int kNearRings = 8;
-  std::vector<int> node_at(mesh.n_vertices(), -1);
-  for (size_t n = 0; n < layout.nodes.size(); ++n) {
-    const int v = layout.nodes[n].vertex;
-    if (v >= 0 && v < static_cast<int>(node_at.size())) node_at[v] = static_cast<int>(n);
-  }
-  std::vector<int> out, dist(mesh.n_vertices(), -1), queue;
-  for (int f : faces) {
-    if (f < 0 || f >= static_cast<int>(mesh.n_faces())) continue;
-    for (int v : queue) dist[v] = -1;
-    queue.clear();
-    for (auto v : mesh.fv_range(mesh.face_handle(f))) dist[v.idx()] = 0, queue.push_back(v.idx());
-    int found = -1;
-    for (size_t head = 0; head < queue.size() && found < 0; ++head) {
-      const int v = queue[head];
-      if (node_at[v] >= 0) {
-        found = node_at[v];
-      } else if (dist[v] < kNearRings) {
-        for (auto w : mesh.vv_range(mesh.vertex_handle(v)))
-          if (dist[w.idx()] < 0) dist[w.idx()] = dist[v] + 1, queue.push_back(w.idx());
-      }
-    }
-    if (found >= 0 && std::find(out.begin(), out.end(), found) == out.end()) out.push_back(found);
-  }
-  return out;
-}
-
 // When fold-overs remain (\p foldovers_left) after orientation constraints that were
 // infeasible, a warning that names the nodes of the written layout next to the faces the
 // constraints could not unfold: where to look at (or edit) the layout.

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/base/errors.h"
+#include "core/layout/layout.h"
 #include "core/layout/layout_io.h"
 #include "core/nodeopt/optimizer.h"
 #include "core/pipeline/pipeline.h"
@@ -290,10 +291,20 @@ StepResult pipeline_step(WorkerState& state, const WorkerObserver& observer) {
     job->mesh = std::move(end.mesh);
     job->layout = std::move(end.layout);
     job->pipeline = std::move(end.pipeline);
-    if (end.orientation.ran)
+    if (end.orientation.ran) {
       prefix += std::string(prefix.empty() ? "" : "; ") + "fold-overs " +
                 std::to_string(end.foldovers_descent) + " -> " +
                 std::to_string(end.foldovers_final) + " by orientation constraints";
+      // Infeasible constraints: the nodes next to the faces they could not unfold.
+      if (end.foldovers_final > 0 && !end.orientation.success) {
+        const std::vector<int> near =
+            nodes_near_faces(job->mesh, job->layout, end.orientation.infeasible_faces);
+        for (size_t i = 0; i < near.size(); ++i)
+          prefix += (i ? ", " : " (infeasible near node ") +
+                    std::to_string(job->layout.nodes[near[i]].id) +
+                    (i + 1 == near.size() ? ")" : "");
+      }
+    }
     const double nodeopt_ms = ms_since(t);
     result = solve_for_display(*job, state, observer, true);
     result.metrics.nodeopt_ms = nodeopt_ms;

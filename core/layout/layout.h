@@ -112,6 +112,12 @@ inline int sigma(int h) {
 //! edges are skipped.
 std::vector<char> arc_edge_mask(const TriMesh& mesh, const Layout& layout);
 
+//! Per face of \p faces (face indices of \p mesh), the layout node nearest to it in vertex rings
+//! (edge hops), at most \p max_rings away; without repeats, in the order of the faces. Indices
+//! into layout.nodes. Out-of-range faces are skipped. Used to name where a solve failed.
+std::vector<int> nodes_near_faces(const TriMesh& mesh, const Layout& layout,
+                                  const std::vector<int>& faces, int max_rings = 8);
+
 //! Builds the rotation system and patches of a layout whose paths are valid (see
 //! validate_layout; call it on layouts with no errors only).
 //! \pre every arc has a path of mesh edges between its end vertices; arcs are disjoint.
