@@ -62,6 +62,12 @@ double cpu_now() {
 }
 
 // Records (CPU time since start, E) of every accepted step.
+// E reaches \p target: equal up to round-off, or below \p floor (values under it are round-off;
+// the polycube's exact layouts end at 1e-22 with E_init 30).
+bool reaches(double E, double target, double floor) {
+  return E <= std::max(target * (1 + 1e-12), floor);
+}
+
 struct Trace : qs::Observer {
   double start = 0;
   bool verbose = false;  // print every step
@@ -73,11 +79,10 @@ struct Trace : qs::Observer {
                   cpu_now() - start);
     if (r.accepted) accepted.push_back({cpu_now() - start, r.E});
   }
-  // CPU time at which E first was ≤ target (negative: never); \p floor: values below it are
-  // round-off (the polycube's exact layouts end at 1e-22 with E_init 30).
+  // CPU time at which E first reached \p target (see reaches; negative: never).
   double time_to(double target, double floor) const {
     for (const auto& [t, E] : accepted)
-      if (E <= std::max(target * (1 + 1e-12), floor)) return t;
+      if (reaches(E, target, floor)) return t;
     return -1;
   }
 };
@@ -311,7 +316,7 @@ int main(int argc, char** argv) {
         // The discrete trajectory, move by move: when it first reaches the continuous final E.
         double disc_reach = -1;
         d.on_move = [&](double E) {
-          if (disc_reach < 0 && E <= std::max(rc.E_final * (1 + 1e-12), 1e-12 * rc.E_init))
+          if (disc_reach < 0 && reaches(E, rc.E_final, 1e-12 * rc.E_init))
             disc_reach = cpu_now() - t0;
         };
         const qs::NodeOptResult rx = qs::relocate_nodes_discrete(c.mesh, start, options, d);

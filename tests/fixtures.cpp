@@ -663,6 +663,18 @@ std::vector<int> ring_vertices(const TriMesh& mesh, int v, int rings) {
   return out;
 }
 
+std::vector<int> ring_distances(const TriMesh& mesh, const std::vector<int>& sources) {
+  std::vector<int> dist(mesh.n_vertices(), -1), queue;
+  for (int v : sources)
+    if (dist[v] < 0) dist[v] = 0, queue.push_back(v);
+  for (size_t head = 0; head < queue.size(); ++head) {
+    const int v = queue[head];
+    for (auto w : mesh.vv_range(mesh.vertex_handle(v)))
+      if (dist[w.idx()] < 0) dist[w.idx()] = dist[v] + 1, queue.push_back(w.idx());
+  }
+  return dist;
+}
+
 Vec3 frozen_field_difference(const TriMesh& mesh, const GeometryCache& geometry,
                              const std::vector<double>& theta, int v, double eps,
                              const MovedEnergy& energy) {

@@ -166,6 +166,9 @@ EmbeddingCheck check_embedding(Pipeline& pipeline);
 //! The vertices at exactly \p rings edge hops from vertex \p v (breadth-first search).
 std::vector<int> ring_vertices(const TriMesh& mesh, int v, int rings);
 
+//! Per vertex (size #V): edge hops to the nearest vertex of \p sources; -1 when unreachable.
+std::vector<int> ring_distances(const TriMesh& mesh, const std::vector<int>& sources);
+
 //! \p layout with every unpinned node moved to a vertex \p rings edge rings away (the choice
 //! rotates with \p seed; vertices other nodes or arcs forbid are skipped), its arcs re-routed:
 //! a valid layout with the same structure.

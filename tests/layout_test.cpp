@@ -54,14 +54,7 @@ TEST(LayoutNodes, NearestNodeOfFaces) {
   EXPECT_EQ(nodes_near_faces(mesh, layout, {f1, f0, f1}), (std::vector<int>{1, 0}));
   // Every face names the node of least ring distance from its vertices.
   std::vector<std::vector<int>> rings;  // [node][vertex]
-  for (const LayoutNode& n : layout.nodes) {
-    std::vector<int> d(mesh.n_vertices(), -1), queue{n.vertex};
-    d[n.vertex] = 0;
-    for (size_t h = 0; h < queue.size(); ++h)
-      for (auto w : mesh.vv_range(mesh.vertex_handle(queue[h])))
-        if (d[w.idx()] < 0) d[w.idx()] = d[queue[h]] + 1, queue.push_back(w.idx());
-    rings.push_back(d);
-  }
+  for (const LayoutNode& n : layout.nodes) rings.push_back(test::ring_distances(mesh, {n.vertex}));
   int far_faces = 0;
   for (auto fh : mesh.faces()) {
     int best = INT_MAX;
@@ -80,6 +73,12 @@ TEST(LayoutNodes, NearestNodeOfFaces) {
   }
   EXPECT_GT(far_faces, 0);
   EXPECT_TRUE(nodes_near_faces(mesh, layout, {-1, static_cast<int>(mesh.n_faces())}).empty());
+  // The wording messages use: each node by id and vertex, in the given order.
+  const LayoutNode &a = layout.nodes[0], &b = layout.nodes[1];
+  EXPECT_EQ(describe_nodes(layout, {1, 0}),
+            "node " + std::to_string(b.id) + " (vertex " + std::to_string(b.vertex) + "), node " +
+                std::to_string(a.id) + " (vertex " + std::to_string(a.vertex) + ")");
+  EXPECT_EQ(describe_nodes(layout, {}), "");
 }
 
 TEST(LayoutTopology, PatchBordersAreOrbitsOfPhi) {

@@ -454,19 +454,6 @@ TEST(OrientationRealData, FandiskInitialLayoutEndsWithoutFoldovers) {
   EXPECT_LE(r.E_final, r.E_descent * 1.05);
 }
 
-// Vertex rings (edge hops) from each vertex to the nearest vertex of \p sources.
-std::vector<int> rings_from(const TriMesh& mesh, const std::vector<int>& sources) {
-  std::vector<int> dist(mesh.n_vertices(), -1), queue;
-  for (int v : sources)
-    if (dist[v] < 0) dist[v] = 0, queue.push_back(v);
-  for (size_t head = 0; head < queue.size(); ++head) {
-    const int v = queue[head];
-    for (auto w : mesh.vv_range(mesh.vertex_handle(v)))
-      if (dist[w.idx()] < 0) dist[w.idx()] = dist[v] + 1, queue.push_back(w.idx());
-  }
-  return dist;
-}
-
 // The faces an infeasible orientation solve on the mask names are where the iso-lines wrap
 // around the free eye holes: each is nearer to an eye hole than to the outer boundary (in vertex
 // rings), and the message names it.
@@ -480,7 +467,8 @@ void expect_named_faces_at_eye_holes(const TriMesh& mesh, const OrientationRepor
             [](const auto& x, const auto& y) { return x.size() > y.size(); });
   std::vector<int> eyes = loops[1];
   eyes.insert(eyes.end(), loops[2].begin(), loops[2].end());
-  const std::vector<int> to_eye = rings_from(mesh, eyes), to_outer = rings_from(mesh, loops[0]);
+  const std::vector<int> to_eye = test::ring_distances(mesh, eyes),
+                         to_outer = test::ring_distances(mesh, loops[0]);
   int nearer_eye = 0;  // of all faces, for scale
   for (auto f : mesh.faces()) {
     int eye = INT_MAX, outer = INT_MAX;

@@ -241,14 +241,17 @@ TEST(Routing, ShortestPathIsAsShortAsPlainDijkstra) {
       double got = 0;
       for (size_t i = 1; i < path.size(); ++i) {
         got += length(path[i - 1], path[i]);
-        if (i + 1 < path.size())
+        if (i + 1 < path.size()) {
           EXPECT_FALSE(o.vertex_blocked[path[i]]) << "passes a blocked vertex";
+        }
       }
       EXPECT_NEAR(got, want, 1e-12 * std::max(1.0, want)) << source << " -> " << target;
       ++compared;
     }
     EXPECT_GT(compared, 10);
-    if (every == 1) EXPECT_GT(unreachable, 10);
+    if (every == 1) {
+      EXPECT_GT(unreachable, 10);
+    }
     std::printf(
         "[stat] every %d arcs as walls: %d paths as short as the reference's, %d unreachable\n",
         every, compared, unreachable);

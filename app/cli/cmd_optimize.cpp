@@ -64,11 +64,8 @@ void warn_about_infeasible_orientation(const OrientationReport& r, int foldovers
   if (foldovers_left <= 0 || !r.ran || r.success || r.infeasible_faces.empty()) return;
   const std::vector<int> near = nodes_near_faces(mesh, layout, r.infeasible_faces);
   std::cerr << "warning: " << foldovers_left << " fold-over(s) remain";
-  for (size_t i = 0; i < near.size(); ++i) {
-    const LayoutNode& n = layout.nodes[near[i]];
-    std::cerr << (i ? ", " : "; the layout cannot be unfolded near ") << "node " << n.id
-              << " (vertex " << n.vertex << ")";
-  }
+  if (!near.empty())
+    std::cerr << "; the layout cannot be unfolded near " << describe_nodes(layout, near);
   std::cerr << ": " << r.message << "\n";
 }
 

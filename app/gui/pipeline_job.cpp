@@ -299,10 +299,7 @@ StepResult pipeline_step(WorkerState& state, const WorkerObserver& observer) {
       if (end.foldovers_final > 0 && !end.orientation.success) {
         const std::vector<int> near =
             nodes_near_faces(job->mesh, job->layout, end.orientation.infeasible_faces);
-        for (size_t i = 0; i < near.size(); ++i)
-          prefix += (i ? ", " : " (infeasible near node ") +
-                    std::to_string(job->layout.nodes[near[i]].id) +
-                    (i + 1 == near.size() ? ")" : "");
+        if (!near.empty()) prefix += " (infeasible near " + describe_nodes(job->layout, near) + ")";
       }
     }
     const double nodeopt_ms = ms_since(t);

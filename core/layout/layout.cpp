@@ -103,6 +103,16 @@ std::vector<int> nodes_near_faces(const TriMesh& mesh, const Layout& layout,
   return out;
 }
 
+std::string describe_nodes(const Layout& layout, const std::vector<int>& nodes) {
+  std::string out;
+  for (int n : nodes) {
+    const LayoutNode& node = layout.nodes[n];
+    out += (out.empty() ? "node " : ", node ") + std::to_string(node.id) + " (vertex " +
+           std::to_string(node.vertex) + ")";
+  }
+  return out;
+}
+
 std::vector<char> arc_edge_mask(const TriMesh& mesh, const Layout& layout) {
   std::vector<char> mask(mesh.n_edges(), 0);
   for (const LayoutArc& arc : layout.arcs)

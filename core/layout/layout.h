@@ -118,6 +118,10 @@ std::vector<char> arc_edge_mask(const TriMesh& mesh, const Layout& layout);
 std::vector<int> nodes_near_faces(const TriMesh& mesh, const Layout& layout,
                                   const std::vector<int>& faces, int max_rings = 8);
 
+//! "node 63 (vertex 5381), node 64 (vertex 5928)": the nodes (indices into layout.nodes) by
+//! id and vertex, for messages. Empty for no nodes.
+std::string describe_nodes(const Layout& layout, const std::vector<int>& nodes);
+
 //! Builds the rotation system and patches of a layout whose paths are valid (see
 //! validate_layout; call it on layouts with no errors only).
 //! \pre every arc has a path of mesh edges between its end vertices; arcs are disjoint.
