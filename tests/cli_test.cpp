@@ -313,6 +313,48 @@ TEST(Cli, OptimizeMovesTheSketchedNodesAndRemovesFoldovers) {
   }
 }
 
+// --time-limit: the node movement ends at the limit and the run finishes from the state reached
+// (the continuous run's fold-over removal, every output), for the continuous and the discrete
+// relocation; the report says so. Without --time-limit nothing is limited; with --no-node-opt the
+// flag is an input error.
+TEST(Cli, TimeLimitEndsTheNodeMovementAndFinishes) {
+  const std::string dir = test::temp_dir("cli_time_limit");
+  std::string out;
+  for (const std::string method : {"", " --discrete-relocation"}) {
+    SCOPED_TRACE(method);
+    ASSERT_EQ(test::run_command(cli("optimize --mesh " + kMesh + " --layout " + kLayout +
+                                    " --out " + dir + " --time-limit 0.001" + method),
+                                &out),
+              0)
+        << out;
+    EXPECT_NE(out.find("the time limit (0.001 s) ended the node movement"), std::string::npos)
+        << out;
+    const auto report = read_json(dir + "/report.json");
+    EXPECT_TRUE(report["node_optimization"]["time_limited"].get<bool>());
+    EXPECT_LE(report["node_optimization"]["steps"].get<int>(), 1);
+    if (method.empty()) {  // the discrete baseline removes no fold-overs
+      EXPECT_EQ(report["metrics"]["foldovers"].get<int>(), 0);
+      EXPECT_TRUE(report["structurally_equivalent"].get<bool>());
+    }
+    for (const char* file : {"param.obj", "layout.json", "field.txt"})
+      EXPECT_TRUE(fs::exists(dir + "/" + file)) << file;
+  }
+  ASSERT_EQ(
+      test::run_command(
+          cli("optimize --quiet --mesh " + kMesh + " --layout " + kLayout + " --out " + dir), &out),
+      0)
+      << out;
+  const auto whole = read_json(dir + "/report.json");
+  EXPECT_FALSE(whole["node_optimization"]["time_limited"].get<bool>());
+  EXPECT_GT(whole["node_optimization"]["steps"].get<int>(), 1);
+  EXPECT_EQ(test::run_command(cli("optimize --no-node-opt --time-limit 5 --mesh " + kMesh +
+                                  " --layout " + kLayout + " --out " + dir),
+                              &out),
+            2)
+      << out;
+  EXPECT_NE(out.find("--time-limit applies to the node optimization"), std::string::npos) << out;
+}
+
 // --no-node-opt --orientation: the fixed nodes' parameterization with strict orientation
 // constraints. The bundled sketch folds with fixed nodes (see above); with --orientation the
 // same nodes give a fold-free, structurally equivalent embedding, and the report says what the

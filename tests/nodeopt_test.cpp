@@ -724,6 +724,60 @@ TEST(NodeOptimizer, CancelsBetweenSolves) {
                Cancelled);
 }
 
+// NodeOptOptions::stop (optimize --time-limit) ends the node movement with the state reached:
+// the same first steps as the whole run, nothing moved after the stop, and the fold-over removal
+// still runs. The bundled sketch folds with its initial node positions.
+TEST(NodeOptimizer, StopEndsTheMovementAndTheFoldoverRemovalStillRuns) {
+  const std::string dir = std::string(QS_ASSETS_DIR) + "/example/";
+  const TriMesh mesh = load_mesh(dir + "ellipsoid.obj");
+  const Layout layout = load_layout(dir + "ellipsoid.layout.json", mesh);
+  const auto descent_steps = [](const Recorder& rec) {
+    return std::count_if(rec.steps.begin(), rec.steps.end(),
+                         [](const StepReport& r) { return r.phase == "descent"; });
+  };
+  Recorder whole_rec;
+  const NodeOptResult whole = optimize_nodes(mesh, layout, PipelineOptions{}, {}, &whole_rec);
+  EXPECT_FALSE(whole.stopped);
+  ASSERT_GT(whole.steps, 3);
+
+  // Stopped at once: the initial state, unfolded by the orientation constraints.
+  NodeOptOptions at_once;
+  at_once.stop = [] { return true; };
+  Recorder rec0;
+  const NodeOptResult r0 = optimize_nodes(mesh, layout, PipelineOptions{}, at_once, &rec0);
+  EXPECT_TRUE(r0.stopped);
+  EXPECT_EQ(r0.steps, 0);
+  EXPECT_EQ(descent_steps(rec0), 0);
+  EXPECT_EQ(node_vertices(r0.layout), node_vertices(layout));
+  EXPECT_GT(r0.foldovers_descent, 0) << "the sketch should fold before the removal";
+  EXPECT_TRUE(r0.orientation.ran);
+  EXPECT_EQ(r0.foldovers_final, 0) << r0.orientation.message;
+
+  // Stopped after three descent steps: the whole run's first three steps, then only the
+  // fold-over removal.
+  NodeOptOptions after3;
+  Recorder rec3;
+  after3.stop = [&] { return descent_steps(rec3) >= 3; };
+  const NodeOptResult r3 = optimize_nodes(mesh, layout, PipelineOptions{}, after3, &rec3);
+  EXPECT_TRUE(r3.stopped);
+  EXPECT_EQ(r3.steps, 3);
+  std::vector<double> whole_E, stopped_E;
+  for (const StepReport& r : whole_rec.steps)
+    if (r.phase == "descent" && whole_E.size() < 3) whole_E.push_back(r.E);
+  for (const StepReport& r : rec3.steps) {
+    if (stopped_E.size() == 3) {  // after the third descent step: fold-over removal only
+      EXPECT_NE(r.phase, "descent");
+      EXPECT_NE(r.phase, "hop");
+    }
+    if (r.phase == "descent") stopped_E.push_back(r.E);
+  }
+  EXPECT_EQ(stopped_E, whole_E);
+  EXPECT_LT(r3.E_descent, r3.E_init);
+  EXPECT_GT(r3.E_descent, whole.E_descent);
+  EXPECT_EQ(r3.foldovers_final, 0);
+  EXPECT_TRUE(validate_layout(r3.mesh, r3.layout).valid());
+}
+
 // ---------------------------------------------------------------------------------------------
 // (d) stiffening
 
@@ -821,6 +875,8 @@ TEST(DiscreteRelocation, StopEndsTheRunWithTheMovesMadeSoFar) {
   const NodeOptResult b = relocate_nodes_discrete(in.mesh, start, PipelineOptions{}, capped, &rec);
   ASSERT_EQ(capped_moves.size(), 1u);
   EXPECT_EQ(polls_after_move, 1);
+  EXPECT_FALSE(a.stopped);
+  EXPECT_TRUE(b.stopped);
   EXPECT_DOUBLE_EQ(capped_moves[0], moves[0]) << "same first move as the whole run";
   EXPECT_DOUBLE_EQ(b.E_final, moves[0]);
   EXPECT_GT(b.E_final, a.E_final);

@@ -81,6 +81,12 @@ int main(int argc, char** argv) {
   cmd_opt->add_flag("--no-align", opt.no_align, "Ignore curvature directions (baseline)");
   cmd_opt->add_flag("--discrete-relocation", opt.discrete_relocation,
                     "Move nodes vertex by vertex (baseline)");
+  cmd_opt
+      ->add_option("--time-limit", opt.time_limit_s,
+                   "Stop moving nodes after this many seconds (wall clock, from the start of the "
+                   "node optimization; with --integer both runs together) and finish from the "
+                   "state reached: fold-over removal and outputs follow")
+      ->check(CLI::PositiveNumber);
   cmd_opt->add_flag("--no-sliding", opt.no_sliding,
                     "Nodes on the boundary and on feature curves stay instead of sliding along "
                     "them; nodes on sharp edges move freely and vertices on sharp edges may be "

@@ -93,6 +93,8 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       throw InvalidInputError(
           "--orientation applies to --no-node-opt runs (the node optimization removes "
           "fold-overs with orientation constraints by default; --no-orientation turns that off)");
+    if (o.time_limit_s > 0 && o.no_node_opt)
+      throw InvalidInputError("--time-limit applies to the node optimization (not --no-node-opt)");
     if (o.orientation && o.no_orientation)
       throw InvalidInputError("--orientation and --no-orientation contradict each other");
     // Node optimization first (it runs its own field + parameterization solves); the final
@@ -101,15 +103,28 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     std::optional<NodeOptResult> node_result;
     ProgressPrinter printer(common.quiet);
     bool warned_about_constraints = false;
+    // --time-limit: one deadline for every node optimization run (set when the first starts).
+    std::optional<std::chrono::steady_clock::time_point> deadline;
+    const auto time_limit = [&]() -> std::function<bool()> {
+      if (o.time_limit_s <= 0) return {};
+      if (!deadline)
+        deadline = std::chrono::steady_clock::now() +
+                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                       std::chrono::duration<double>(o.time_limit_s));
+      const auto end = *deadline;
+      return [end] { return std::chrono::steady_clock::now() >= end; };
+    };
     const auto optimize = [&](const TriMesh& start_mesh, const Layout& start_layout,
                               const PipelineOptions& run_options) {
       if (o.discrete_relocation) {
         DiscreteOptions d;
         d.max_steps = o.steps;
+        d.stop = time_limit();
         return relocate_nodes_discrete(start_mesh, start_layout, run_options, d, &printer);
       }
       NodeOptOptions no;
       no.max_steps = o.steps;
+      no.stop = time_limit();
       no.gradient = o.gradient == "exact" ? GradientMethod::Exact : GradientMethod::Estimator;
       no.orientation_at_end = !o.no_orientation;
       no.slide_on_curves = !o.no_sliding;
@@ -226,6 +241,11 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
                                    {"phase", r.phase},
                                    {"moved_nodes", r.moved_nodes}});
       }
+      const bool time_limited = node_result->stopped || (relaxed_result && relaxed_result->stopped);
+      if (time_limited && !common.quiet)
+        std::cerr << "optimize: the time limit (" << o.time_limit_s
+                  << " s) ended the node movement after " << node_result->steps
+                  << " descent step(s); fold-over removal and outputs from the state reached\n";
       report["node_optimization"] = {
           {"method", o.discrete_relocation ? "discrete" : o.gradient},
           {"steps", node_result->steps},
@@ -242,7 +262,8 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
           {"fold_removal", node_result->orientation_constraints ? "orientation"
                            : !node_result->face_weights.empty() ? "stiffening"
                                                                 : "none"},
-          {"orientation", orientation_json(node_result->orientation)}};
+          {"orientation", orientation_json(node_result->orientation)},
+          {"time_limited", time_limited}};
       warn_about_infeasible_orientation(node_result->orientation, param.foldovers, pipeline.mesh(),
                                         pipeline.layout());
     }

@@ -44,6 +44,8 @@ struct OptimizeOptions {
   double sharp_angle_deg = 35.0;
   int max_cluster_faces = CrossFieldOptions{}.max_cluster_faces;
   int threads = 1;  //!< math-library threads (core/base/solver_threads.h)
+  //! Wall-clock seconds for moving nodes (all node optimization runs together); 0: no limit.
+  double time_limit_s = 0;
 };
 
 struct ImportQuadsOptions {

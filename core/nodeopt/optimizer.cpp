@@ -492,6 +492,7 @@ struct NodeOptimizer::Impl {
     auto run_sweep = [&](const std::vector<int>& nodes, const std::vector<Vec3>& directions,
                          HopSweepOptions sweep, bool counts_evaluations) {
       sweep.relocation = no.relocation;
+      sweep.stop = no.stop;
       if (nodes.empty() || sweep.max_evaluations <= 0) return;
       const HopSweepResult s =
           hop_sweep(original, hopped.mesh, hopped.layout, nodes, directions, h.E, h.foldovers,
@@ -540,7 +541,7 @@ struct NodeOptimizer::Impl {
     // All at once first, one solve (single moves miss collective optima: one node on its cone
     // or vertex while its neighbours are not can raise E): every relocation undone and every
     // node off its cone onto its nearest fitting vertex.
-    if (no.hop_collective) {
+    if (no.hop_collective && !stop_requested()) {
       check_cancel(observer);
       State all = hopped;
       int moved = 0;
@@ -657,6 +658,8 @@ struct NodeOptimizer::Impl {
     return kept;
   }
 
+  bool stop_requested() const { return no.stop && no.stop(); }
+
   // When a descent phase ends: a hop sweep; true when nodes hopped and a new phase begins.
   bool polish() {
     if (!no.hop_polish || polish_rounds >= no.max_hop_rounds) return false;
@@ -680,6 +683,11 @@ struct NodeOptimizer::Impl {
   // run and been reported in that call.
   bool step() {
     if (descent_over) return false;
+    if (stop_requested()) {
+      result.stopped = true;
+      descent_over = true;
+      return false;
+    }
     if (!started) {
       started = true;
       if (no.hop_polish && no.hop_cones_first && !movable.empty()) {

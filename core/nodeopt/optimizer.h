@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -180,6 +181,11 @@ struct NodeOptOptions {
   OrientationOptions orientation;
   bool stiffen_at_end = true;  //!< stiffening (§7.1) when fold-overs remain after that
   StiffeningOptions stiffening;
+  //! Ends the node movement early when it returns true (a time limit): polled before each
+  //! descent step and hop sweep and before each candidate solve inside a sweep. The state
+  //! reached so far is kept (a sweep keeps the hops it made), finish() still removes
+  //! fold-overs, and NodeOptResult::stopped says so. Empty: no early end.
+  std::function<bool()> stop;
 };
 
 struct NodeOptResult {
@@ -207,6 +213,9 @@ struct NodeOptResult {
   //! removal: that state was returned.
   bool fewest_foldovers_reverted = false;
   int stiffening_iterations = 0;
+  //! NodeOptOptions::stop (or DiscreteOptions::stop) ended the node movement before the
+  //! descent and polish (the discrete sweeps) were over.
+  bool stopped = false;
   //! The final solve uses the orientation constraints: re-solving the final (mesh, layout)
   //! needs ParamOptions::orientation.enabled (and `orientation_options`) to reproduce it;
   //! `pipeline` then holds that constrained solve. foldovers_descent is the count before.
