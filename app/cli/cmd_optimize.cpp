@@ -245,7 +245,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       if (time_limited && !common.quiet)
         std::cerr << "optimize: the time limit (" << o.time_limit_s
                   << " s) ended the node movement after " << node_result->steps
-                  << " descent step(s); fold-over removal and outputs from the state reached\n";
+                  << " step(s); the run finishes from the state reached\n";
       report["node_optimization"] = {
           {"method", o.discrete_relocation ? "discrete" : o.gradient},
           {"steps", node_result->steps},
