@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
       ->add_option("--time-limit", opt.time_limit_s,
                    "Stop moving nodes after this many seconds (wall clock, from the start of the "
                    "node optimization; with --integer both runs together) and finish from the "
-                   "state reached: fold-over removal and outputs follow")
+                   "state reached (the continuous run still removes fold-overs)")
       ->check(CLI::PositiveNumber);
   cmd_opt->add_flag("--no-sliding", opt.no_sliding,
                     "Nodes on the boundary and on feature curves stay instead of sliding along "
