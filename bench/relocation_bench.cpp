@@ -61,13 +61,13 @@ double cpu_now() {
   return qs::bench::cpu_seconds();
 }
 
-// Records (CPU time since start, E) of every accepted step.
 // E reaches \p target: equal up to round-off, or below \p floor (values under it are round-off;
 // the polycube's exact layouts end at 1e-22 with E_init 30).
 bool reaches(double E, double target, double floor) {
   return E <= std::max(target * (1 + 1e-12), floor);
 }
 
+// Records (CPU time since start, E) of every accepted step.
 struct Trace : qs::Observer {
   double start = 0;
   bool verbose = false;  // print every step

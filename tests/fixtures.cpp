@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -673,6 +674,12 @@ std::vector<int> ring_distances(const TriMesh& mesh, const std::vector<int>& sou
       if (dist[w.idx()] < 0) dist[w.idx()] = dist[v] + 1, queue.push_back(w.idx());
   }
   return dist;
+}
+
+int face_ring_distance(const TriMesh& mesh, const std::vector<int>& dist, int f) {
+  int d = INT_MAX;
+  for (auto v : mesh.fv_range(mesh.face_handle(f))) d = std::min(d, dist[v.idx()]);
+  return d;
 }
 
 Vec3 frozen_field_difference(const TriMesh& mesh, const GeometryCache& geometry,

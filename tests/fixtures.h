@@ -169,6 +169,9 @@ std::vector<int> ring_vertices(const TriMesh& mesh, int v, int rings);
 //! Per vertex (size #V): edge hops to the nearest vertex of \p sources; -1 when unreachable.
 std::vector<int> ring_distances(const TriMesh& mesh, const std::vector<int>& sources);
 
+//! The least of \p dist (per vertex, as ring_distances gives) over the vertices of face \p f.
+int face_ring_distance(const TriMesh& mesh, const std::vector<int>& dist, int f);
+
 //! \p layout with every unpinned node moved to a vertex \p rings edge rings away (the choice
 //! rotates with \p seed; vertices other nodes or arcs forbid are skipped), its arcs re-routed:
 //! a valid layout with the same structure.

@@ -60,7 +60,7 @@ TEST(LayoutNodes, NearestNodeOfFaces) {
     int best = INT_MAX;
     std::vector<int> dist(layout.nodes.size(), INT_MAX);
     for (size_t n = 0; n < layout.nodes.size(); ++n)
-      for (auto v : mesh.fv_range(fh)) dist[n] = std::min(dist[n], rings[n][v.idx()]);
+      dist[n] = test::face_ring_distance(mesh, rings[n], fh.idx());
     for (int d : dist) best = std::min(best, d);
     const std::vector<int> near = nodes_near_faces(mesh, layout, {fh.idx()});
     ASSERT_EQ(near.size(), 1u) << "face " << fh.idx();

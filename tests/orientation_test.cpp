@@ -8,7 +8,6 @@
 
 #include <Eigen/SparseCholesky>
 #include <algorithm>
-#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -470,20 +469,16 @@ void expect_named_faces_at_eye_holes(const TriMesh& mesh, const OrientationRepor
   const std::vector<int> to_eye = test::ring_distances(mesh, eyes),
                          to_outer = test::ring_distances(mesh, loops[0]);
   int nearer_eye = 0;  // of all faces, for scale
-  for (auto f : mesh.faces()) {
-    int eye = INT_MAX, outer = INT_MAX;
-    for (auto v : mesh.fv_range(f))
-      eye = std::min(eye, to_eye[v.idx()]), outer = std::min(outer, to_outer[v.idx()]);
-    nearer_eye += eye < outer;
-  }
+  for (auto f : mesh.faces())
+    nearer_eye += test::face_ring_distance(mesh, to_eye, f.idx()) <
+                  test::face_ring_distance(mesh, to_outer, f.idx());
   std::printf("[stat] mask: %d of %zu faces are nearer to an eye hole than to the outer boundary\n",
               nearer_eye, static_cast<size_t>(mesh.n_faces()));
   for (int f : named) {
     ASSERT_GE(f, 0);
     ASSERT_LT(f, static_cast<int>(mesh.n_faces()));
-    int eye = INT_MAX, outer = INT_MAX;
-    for (auto v : mesh.fv_range(mesh.face_handle(f)))
-      eye = std::min(eye, to_eye[v.idx()]), outer = std::min(outer, to_outer[v.idx()]);
+    const int eye = test::face_ring_distance(mesh, to_eye, f),
+              outer = test::face_ring_distance(mesh, to_outer, f);
     std::printf(
         "[stat] mask: named face %d, %d rings from an eye hole, %d from the outer boundary\n", f,
         eye, outer);

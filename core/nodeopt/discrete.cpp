@@ -289,7 +289,7 @@ NodeOptResult relocate_nodes_discrete(const TriMesh& mesh, const Layout& layout,
     result.reports.push_back(r);
     if (observer) observer->on_step(r);
     if (s.moved > 0) ++result.accepted;
-    if (s.stopped) result.stopped = true;
+    result.stopped = s.stopped;
     if (s.moved == 0 || s.stopped) break;
   }
   result.E_descent = result.E_final = E;
