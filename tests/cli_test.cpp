@@ -316,7 +316,7 @@ TEST(Cli, OptimizeMovesTheSketchedNodesAndRemovesFoldovers) {
 // --time-limit: the node movement ends at the limit and the run finishes from the state reached
 // (the continuous run's fold-over removal, every output), for the continuous and the discrete
 // relocation; the report says so. Without --time-limit nothing is limited; with --no-node-opt the
-// flag is an input error.
+// flag is an input error, and a limit that is not positive a usage error.
 TEST(Cli, TimeLimitEndsTheNodeMovementAndFinishes) {
   const std::string dir = test::temp_dir("cli_time_limit");
   std::string out;
@@ -353,6 +353,18 @@ TEST(Cli, TimeLimitEndsTheNodeMovementAndFinishes) {
             2)
       << out;
   EXPECT_NE(out.find("--time-limit applies to the node optimization"), std::string::npos) << out;
+  // A limit that is not a positive number is a usage error (exit code 1, like every malformed
+  // option) that says what the flag needs.
+  for (const std::string bad : {"0", "-2", "soon"}) {
+    EXPECT_EQ(test::run_command(cli("optimize --time-limit " + bad + " --mesh " + kMesh +
+                                    " --layout " + kLayout + " --out " + dir),
+                                &out),
+              1)
+        << out;
+    EXPECT_NE(out.find("--time-limit: must be a positive number of seconds, got " + bad),
+              std::string::npos)
+        << out;
+  }
 }
 
 // --no-node-opt --orientation: the fixed nodes' parameterization with strict orientation

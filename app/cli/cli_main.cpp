@@ -86,7 +86,14 @@ int main(int argc, char** argv) {
                    "Stop moving nodes after this many seconds (wall clock, from the start of the "
                    "node optimization; with --integer both runs together) and finish from the "
                    "state reached (the continuous run still removes fold-overs)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            double value = 0;
+            return CLI::detail::lexical_cast(text, value) && value > 0
+                       ? ""
+                       : "must be a positive number of seconds, got " + text;
+          },
+          "SECONDS > 0"));
   cmd_opt->add_flag("--no-sliding", opt.no_sliding,
                     "Nodes on the boundary and on feature curves stay instead of sliding along "
                     "them; nodes on sharp edges move freely and vertices on sharp edges may be "
