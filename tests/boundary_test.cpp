@@ -260,7 +260,8 @@ TEST(Boundary, SplitClustersSettleTheBoundaryAsWithoutCurvature) {
 // at every descent step, and the passes cost four to six factorizations each time). On the
 // conjugate layout of inspired_mesh, whose boundary constraints are released: an update with
 // the same layout drops the same boundary faces as the construction with fewer factorizations
-// (no structural pass, no full factorization), and an update with moved nodes still settles the
+// (no structural pass, no full factorization, the structural pass's factorization reused), and
+// an update with moved nodes still settles the
 // boundary as a run without curvature constraints does.
 TEST(Boundary, SplitClusterUpdatesStartFromTheLastStructuralDrops) {
   const std::string dir = test::shared_meshes_dir();
@@ -292,6 +293,9 @@ TEST(Boundary, SplitClusterUpdatesStartFromTheLastStructuralDrops) {
   const int update_passes = again.timings.conflict_passes - built.timings.conflict_passes;
   EXPECT_LT(update_passes, built.timings.conflict_passes);
   EXPECT_LT(update_factorizations, built_factorizations);
+  // The structural matrix with the construction's drops is the one factorized last by the
+  // construction's structural pass: the update takes that factorization over.
+  EXPECT_GT(again.timings.reused_factorizations, built.timings.reused_factorizations);
   std::printf(
       "[stat] inspired_mesh --coarsen 16, split clusters: %d factorizations and %d drop passes to "
       "build the field, %d and %d to update it with the same layout\n",

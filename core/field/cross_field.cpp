@@ -724,9 +724,24 @@ void CrossFieldSolver::drop_structural_conflicts(const TriMesh& mesh, const Geom
       if (again[cl]) cluster_active_[cl] = 0;
     pin_gauge_if_unconstrained();
   }
-  factorize_as_current();
+  // The matrix of the feature and boundary constraints alone changes only when their drops do:
+  // update_layout after a descent step usually factorizes the last step's matrix again.
+  if (structural_.factorized() && structural_.same_pattern(matrix_) &&
+      std::equal(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(),
+                 structural_values_.begin(), structural_values_.end())) {
+    std::swap(solver_, spare_);
+    solver_ = structural_;  // shared (copy-on-write)
+    current_ = true;
+    ++field_.timings.reused_factorizations;
+  } else {
+    factorize_as_current();
+  }
   solve(g);
   drop_conflicting_clusters(mesh, g, tolerated);
+  if (current_) {  // the structural matrix after its drops, for the next pass
+    structural_ = solver_;
+    structural_values_.assign(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros());
+  }
   structural_dropped_.assign(g.n_faces, 0);
   for (int k = 0; k < nc; ++k)
     if (!is_curvature(k) && !active(k)) structural_dropped_[field_.constraints.face[k]] = 1;
@@ -982,7 +997,7 @@ const CrossField& CrossFieldSolver::update_layout(const TriMesh& mesh, const Geo
 }
 
 void CrossFieldSolver::unshare_solvers() {
-  for (SpdSolver* s : {&solver_, &spare_, &reference_, &full_}) s->unshare();
+  for (SpdSolver* s : {&solver_, &spare_, &reference_, &full_, &structural_}) s->unshare();
 }
 
 void CrossFieldSolver::rotate(double phi) {

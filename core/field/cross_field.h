@@ -91,8 +91,11 @@ struct CrossFieldTimings {
   //! split mode: the ReferenceRotation callback (the Pipeline's: one parameterization setup
   //! and factorization), not part of warm_start_s
   double reference_rotation_s = 0;
-  double setup_s = 0;       //!< whole constructor
-  int factorizations = 0;   //!< numeric factorizations in the setup
+  double setup_s = 0;      //!< whole constructor
+  int factorizations = 0;  //!< numeric factorizations in the setup
+  //! factorizations taken over from an earlier one of the same matrix instead (the structural
+  //! pass's, CrossFieldSolver::drop_structural_conflicts)
+  int reused_factorizations = 0;
   int solves = 0;           //!< back-substitutions (setup and re-solves)
   int rounding_passes = 0;  //!< extra solves after re-rounding cluster rotations (last solve)
   int conflict_passes = 0;  //!< re-solves after dropping contradicting clusters
@@ -311,6 +314,10 @@ class CrossFieldSolver {
   //! Per face: a feature or boundary constraint there was dropped by the last structural pass
   //! (empty before the first).
   std::vector<char> structural_dropped_;
+  //! The last factorization of the structural pass (feature and boundary constraints only) and
+  //! its matrix's values (same pattern as matrix_): the next pass with the same drops reuses it.
+  SpdSolver structural_{"cross field"};
+  std::vector<double> structural_values_;
 };
 
 //! What became of a field's direction constraints: how many faces each kind constrained and how
