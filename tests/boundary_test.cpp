@@ -261,8 +261,8 @@ TEST(Boundary, SplitClustersSettleTheBoundaryAsWithoutCurvature) {
 // conjugate layout of inspired_mesh, whose boundary constraints are released: an update with
 // the same layout drops the same boundary faces as the construction with fewer factorizations
 // (no structural pass, no full factorization, the structural pass's factorization reused), and
-// an update with moved nodes still settles the
-// boundary as a run without curvature constraints does.
+// an update with moved nodes still settles the boundary as a run without curvature constraints
+// does.
 TEST(Boundary, SplitClusterUpdatesStartFromTheLastStructuralDrops) {
   const std::string dir = test::shared_meshes_dir();
   if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes is absent (real-mesh test)";

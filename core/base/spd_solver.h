@@ -14,8 +14,8 @@ struct SpdSolverStats {
   double analyze_s = 0, factorize_s = 0, solve_s = 0;
   int analyses = 0, factorizations = 0, solves = 0;
   int hinted_analyses = 0;  //!< analyses that used a given ordering (set_ordering_hint)
-  //! factorizations that scattered A's values into the lower triangle of P·A·Pᵀ laid out by
-  //! the analysis (every one of a compressed matrix), not through CHOLMOD's permuted transposes
+  //! factorizations that scattered A's values into the lower triangle of P·A·Pᵀ, laid out once
+  //! per analysis (every one of a compressed matrix), instead of CHOLMOD's permuted transposes
   int scattered_factorizations = 0;
 };
 
