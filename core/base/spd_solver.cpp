@@ -242,6 +242,17 @@ struct SpdSolver::Impl {
   // first waits for it (std::async's future), before the factor it writes is freed.
   std::future<AnalysisResult> pending;
 
+  //! The analyzed pattern's bookkeeping of \p from (size, pattern, triangle, P·A·Pᵀ layout),
+  //! for a state that took over \p from's CHOLMOD factor; analyzed and factorized are the
+  //! caller's to set.
+  void take_pattern_of(const Impl& from) {
+    rows = from.rows;
+    nnz = from.nnz;
+    outer = from.outer;
+    inner = from.inner;
+    upper = from.upper;
+    permuted = from.permuted;
+  }
   //! Waits for a pending analysis (without taking its result).
   void wait() const {
     if (pending.valid()) pending.wait();
@@ -292,13 +303,8 @@ void SpdSolver::detach(bool keep_analysis) {
   if (impl_.use_count() <= 1) return;
   auto own = std::make_shared<Impl>();
   if (keep_analysis && impl_->analyzed && own->llt.copy_analysis_from(impl_->llt)) {
-    own->rows = impl_->rows;
-    own->nnz = impl_->nnz;
-    own->outer = impl_->outer;
-    own->inner = impl_->inner;
+    own->take_pattern_of(*impl_);
     own->analyzed = true;
-    own->upper = impl_->upper;
-    own->permuted = impl_->permuted;
   }
   impl_ = std::move(own);
 }
@@ -309,14 +315,9 @@ void SpdSolver::unshare() {
   auto own = std::make_shared<Impl>();
   if (impl_->analyzed && !own->llt.copy_factor_from(impl_->llt))
     throw SolverError(stage_ + ": could not copy the factorization");
-  own->rows = impl_->rows;
-  own->nnz = impl_->nnz;
-  own->outer = impl_->outer;
-  own->inner = impl_->inner;
+  own->take_pattern_of(*impl_);
   own->analyzed = impl_->analyzed;
   own->factorized = impl_->factorized;
-  own->upper = impl_->upper;
-  own->permuted = impl_->permuted;
   impl_ = std::move(own);
 }
 
@@ -429,13 +430,8 @@ bool SpdSolver::copy_analysis_from(const SpdSolver& other) {
   const auto t0 = std::chrono::steady_clock::now();
   detach(false);
   if (!impl_->llt.copy_analysis_from(other.impl_->llt)) return false;
-  impl_->rows = other.impl_->rows;
-  impl_->nnz = other.impl_->nnz;
-  impl_->outer = other.impl_->outer;
-  impl_->inner = other.impl_->inner;
+  impl_->take_pattern_of(*other.impl_);
   impl_->analyzed = true;
-  impl_->upper = other.impl_->upper;
-  impl_->permuted = other.impl_->permuted;
   impl_->factorized = false;
   stats_.analyze_s = seconds_since(t0);
   return true;
