@@ -223,7 +223,8 @@ TEST(Relayout, MovedNodesGiveTheFreshFieldTopology) {
 }
 
 // The cached obstacles of move_node_and_reroute give the same re-routed layouts and forbidden
-// vertex sets as rebuilding them per move, and stay equal to obstacles_of_layout.
+// vertex sets as rebuilding them per move (vertex by vertex too: relocation_forbidden), and
+// stay equal to obstacles_of_layout.
 TEST(Relayout, CachedObstaclesMatchRebuiltOnes) {
   const Example ex = ellipsoid_example();
   Layout slow = ex.layout, fast = ex.layout;
@@ -236,6 +237,9 @@ TEST(Relayout, CachedObstaclesMatchRebuiltOnes) {
       const auto forbidden_slow = forbidden_relocation_vertices(ex.mesh, slow, n);
       const auto forbidden_fast = forbidden_relocation_vertices(fast, n, cache);
       ASSERT_EQ(forbidden_slow, forbidden_fast) << "round " << round << " node " << n;
+      for (int v = 0; v < static_cast<int>(forbidden_fast.size()); ++v)
+        ASSERT_EQ(relocation_forbidden(fast, n, cache, v), forbidden_fast[v] != 0)
+            << "round " << round << " node " << n << " vertex " << v;
       auto cand = test::ring_vertices(ex.mesh, slow.nodes[n].vertex, 1 + round % 2);
       std::shuffle(cand.begin(), cand.end(), rng);
       for (int w : cand) {

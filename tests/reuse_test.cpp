@@ -199,6 +199,7 @@ TEST(ReuseField, IncrementalGeometryIsBitIdentical) {
       ASSERT_NEAR(g.kappa[e], full.kappa[e], 1e-13) << "round " << round << " edge " << e;
     ASSERT_EQ(g.face_area, full.face_area);
     ASSERT_EQ(g.corner_angle, full.corner_angle);
+    ASSERT_EQ(g.face_gradient, full.face_gradient);
     ASSERT_EQ(g.angle_defect, full.angle_defect);
     ASSERT_EQ(g.edge_length, full.edge_length);
     ASSERT_EQ(g.mean_edge_length, full.mean_edge_length);
@@ -208,6 +209,19 @@ TEST(ReuseField, IncrementalGeometryIsBitIdentical) {
       ASSERT_EQ(g.face_frame[f], full.face_frame[f]) << "face " << f;
     }
     for (size_t e = 0; e < g.kappa.size(); ++e) changed_kappa += g.kappa[e] != kappa_before[e];
+    // The kept hat-function gradients are those of the moved corners in the current frames:
+    // ∇φ_k · (c_j − c_0) = δ_kj − δ_k0, and their area is the face's.
+    for (int f = 0; f < g.n_faces; ++f) {
+      const auto c = face_corners_2d(mesh, g, f);
+      const auto& grad = g.face_gradient[f];
+      for (int k = 0; k < 3; ++k)
+        for (int j = 1; j < 3; ++j) {
+          const double dot =
+              grad[2 * k] * (c[j][0] - c[0][0]) + grad[2 * k + 1] * (c[j][1] - c[0][1]);
+          ASSERT_NEAR(dot, (k == j) - (k == 0), 1e-9) << "face " << f << " corner " << k;
+        }
+      ASSERT_NEAR(grad[6], g.face_area[f], 1e-12 * g.face_area[f]) << "face " << f;
+    }
   }
   EXPECT_GT(changed_kappa, 0) << "the moves did not change κ";
   // A fresh build at the final positions has the same geometry (κ up to multiples of 2π).

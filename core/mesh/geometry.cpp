@@ -56,6 +56,20 @@ void compute_face(const TriMesh& mesh, GeometryCache& g, int f) {
     const Vec3 a = p[(k + 1) % 3] - p[k], b = p[(k + 2) % 3] - p[k];
     g.corner_angle[3 * f + k] = std::atan2((a % b).norm(), a | b);
   }
+  // Hat-function gradients in the frame just set: ∇φ_k is the opposite edge e_k turned by 90°
+  // (−e_y, e_x), divided by twice the area.
+  const auto c = face_corners_2d(mesh, g, f);
+  const double e1x = c[1][0] - c[0][0], e1y = c[1][1] - c[0][1];
+  const double e2x = c[2][0] - c[0][0], e2y = c[2][1] - c[0][1];
+  const double a2 = e1x * e2y - e1y * e2x;
+  std::array<double, 7>& grad = g.face_gradient[f];
+  for (int k = 0; k < 3; ++k) {
+    const auto& from = c[(k + 1) % 3];
+    const auto& to = c[(k + 2) % 3];
+    grad[2 * k] = -(to[1] - from[1]) / a2;
+    grad[2 * k + 1] = (to[0] - from[0]) / a2;
+  }
+  grad[6] = 0.5 * a2;
 }
 
 // Length and κ of edge e (κ continued from \p old_kappa when given).
@@ -197,6 +211,7 @@ void compute_geometry(const TriMesh& mesh, GeometryCache& g, bool continue_kappa
   g.face_normal.resize(nf);
   g.face_frame.resize(nf);
   g.face_area.resize(nf);
+  g.face_gradient.resize(nf);
   g.corner_angle.resize(3 * nf);
   g.angle_defect.assign(g.n_vertices, 0.0);
   std::vector<double> angle_sum(g.n_vertices, 0.0);

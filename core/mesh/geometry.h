@@ -35,6 +35,12 @@ struct GeometryCache {
   //! 0 by default (tests use random offsets: nothing may depend on the frame choice). Size #F.
   std::vector<double> frame_offset;
   std::vector<double> face_area;  //!< size #F
+  //! Per face f: the gradients of the linear hat functions of its three corners in the frame
+  //! (r_f, n_f × r_f), from face_corners_2d: ∇φ_k = (face_gradient[f][2k],
+  //! face_gradient[f][2k + 1]) (1/length), and [6] the area of those 2D corners (length²; equal
+  //! to face_area up to rounding). Kept with the frames, so the energy assembly and its
+  //! measurements do not recompute them for every solve. Size #F.
+  std::vector<std::array<double, 7>> face_gradient;
   //! Corner angle (radians) at the k-th corner of face f: corner_angle[3f + k].
   std::vector<double> corner_angle;
   //! Angle defect Ω(v): 2π − Σ angles (interior), π − Σ angles (boundary). Size #V.

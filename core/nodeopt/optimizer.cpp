@@ -791,9 +791,9 @@ struct NodeOptimizer::Impl {
             continue;
           }
         }
-        const std::vector<char> forbidden =
-            no_switch[i] ? std::vector<char>(trial.mesh.n_vertices(), 1)
-                         : forbidden_relocation_vertices(trial.layout, n, obstacles);
+        const auto forbidden = [&](int u) {
+          return no_switch[i] || relocation_forbidden(trial.layout, n, obstacles, u);
+        };
         const int w = choose_relocation_vertex(trial.mesh, original, tr.end, tr.end_position, v,
                                                forbidden, no.relocation);
         if (w < 0) continue;

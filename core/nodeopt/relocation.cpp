@@ -67,10 +67,19 @@ bool relocation_keeps_orientation(const TriMesh& mesh, const TriMesh& original, 
 int choose_relocation_vertex(const TriMesh& mesh, const TriMesh& original,
                              const SurfacePoint& target_point, const Vec3& target, int node_vertex,
                              const std::vector<char>& forbidden, const RelocationOptions& options) {
+  return choose_relocation_vertex(
+      mesh, original, target_point, target, node_vertex, [&](int v) { return forbidden[v] != 0; },
+      options);
+}
+
+int choose_relocation_vertex(const TriMesh& mesh, const TriMesh& original,
+                             const SurfacePoint& target_point, const Vec3& target, int node_vertex,
+                             const std::function<bool(int)>& forbidden,
+                             const RelocationOptions& options) {
   std::vector<std::pair<double, int>> candidates;
   for (auto vh : original.fv_range(original.face_handle(target_point.face))) {
     const int v = vh.idx();
-    if (v != node_vertex && forbidden[v]) continue;
+    if (v != node_vertex && forbidden(v)) continue;
     candidates.push_back({(original.point(vh) - target).sqrnorm(), v});
   }
   std::sort(candidates.begin(), candidates.end());
@@ -139,6 +148,23 @@ std::vector<char> forbidden_relocation_vertices(const Layout& layout, int node_i
   for (size_t n = 0; n < layout.nodes.size(); ++n)
     if (static_cast<int>(n) != node_index) out[layout.nodes[n].vertex] = 1;
   return out;
+}
+
+bool relocation_forbidden(const Layout& layout, int node_index, const LayoutObstacles& obstacles,
+                          int v) {
+  // The order of forbidden_relocation_vertices' rules: other nodes' vertices last (always
+  // forbidden), then the node's own vertex and arcs (only when fixed), then every blocked one.
+  for (size_t n = 0; n < layout.nodes.size(); ++n)
+    if (static_cast<int>(n) != node_index && layout.nodes[n].vertex == v) return true;
+  const bool fixed = obstacles.fixed[v] != 0;
+  if (v == layout.nodes[node_index].vertex) return fixed;
+  if (!obstacles.routing.vertex_blocked[v]) return fixed;
+  const int id = layout.nodes[node_index].id;
+  for (const auto& arc : layout.arcs)
+    if ((arc.from == id || arc.to == id) &&
+        std::find(arc.path.begin(), arc.path.end(), v) != arc.path.end())
+      return fixed;
+  return true;
 }
 
 bool same_layout_structure(const LayoutTopology& a, const LayoutTopology& b) {

@@ -99,6 +99,11 @@ int choose_relocation_vertex(const TriMesh& mesh, const TriMesh& original,
                              const SurfacePoint& target_point, const Vec3& target, int node_vertex,
                              const std::vector<char>& forbidden,
                              const RelocationOptions& options = {});
+//! The same with \p forbidden asked only for the face's corners (relocation_forbidden).
+int choose_relocation_vertex(const TriMesh& mesh, const TriMesh& original,
+                             const SurfacePoint& target_point, const Vec3& target, int node_vertex,
+                             const std::function<bool(int)>& forbidden,
+                             const RelocationOptions& options = {});
 
 //! Vertices a moving node may not be relocated onto (size #V): other nodes' vertices, boundary
 //! vertices, vertices of feature edges, and vertices of arcs not incident to node \p node_index
@@ -109,6 +114,10 @@ std::vector<char> forbidden_relocation_vertices(const TriMesh& mesh, const Layou
 //! arcs instead of every arc path.
 std::vector<char> forbidden_relocation_vertices(const Layout& layout, int node_index,
                                                 const LayoutObstacles& obstacles);
+//! One entry of forbidden_relocation_vertices(layout, node_index, obstacles), vertex \p v,
+//! without building the #V array (a descent step asks for three vertices per node).
+bool relocation_forbidden(const Layout& layout, int node_index, const LayoutObstacles& obstacles,
+                          int v);
 
 //! A node sliding along a curve to another vertex (move_node_and_reroute).
 struct CurveWalk {

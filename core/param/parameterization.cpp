@@ -89,19 +89,12 @@ void compact(Terms& t) {
   t.swap(out);
 }
 
-// Local 2D gradient operator of face f: ∇φ_k (2D, in the frame r_f, n×r_f), and the area.
-void face_gradients(const TriMesh& mesh, const GeometryCache& g, int f,
-                    Eigen::Matrix<double, 2, 3>& G, double& area) {
-  const auto corners = face_corners_2d(mesh, g, f);
-  Eigen::Vector2d p[3];
-  for (int c = 0; c < 3; ++c) p[c] = Eigen::Vector2d(corners[c][0], corners[c][1]);
-  const Eigen::Vector2d e1 = p[1] - p[0], e2 = p[2] - p[0];
-  const double a2 = e1.x() * e2.y() - e1.y() * e2.x();  // 2A
-  area = 0.5 * a2;
-  for (int k = 0; k < 3; ++k) {
-    const Eigen::Vector2d e = p[(k + 2) % 3] - p[(k + 1) % 3];
-    G.col(k) = Eigen::Vector2d(-e.y(), e.x()) / a2;
-  }
+// Local 2D gradient operator of face f: ∇φ_k (2D, in the frame r_f, n×r_f), and the area
+// (GeometryCache::face_gradient).
+void face_gradients(const GeometryCache& g, int f, Eigen::Matrix<double, 2, 3>& G, double& area) {
+  const std::array<double, 7>& grad = g.face_gradient[f];
+  for (int k = 0; k < 3; ++k) G.col(k) = Eigen::Vector2d(grad[2 * k], grad[2 * k + 1]);
+  area = grad[6];
 }
 
 }  // namespace
@@ -485,7 +478,7 @@ const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCa
   for (int f = 0; f < g.n_faces; ++f) {
     Eigen::Matrix<double, 2, 3> G;
     double area;
-    face_gradients(mesh, g, f, G, area);
+    face_gradients(g, f, G, area);
     if (!options_.face_weights.empty()) area *= options_.face_weights[f];
     const Eigen::Vector2d u(std::cos(theta[f]), std::sin(theta[f])), v(-u.y(), u.x());
     const Eigen::Matrix2d Wu = u * u.transpose() + aniso * v * v.transpose();
@@ -564,7 +557,7 @@ double ParamSolver::optimal_field_rotation(const TriMesh& mesh, const GeometryCa
   for (int f = 0; f < g.n_faces; ++f) {
     Eigen::Matrix<double, 2, 3> G;
     double area;
-    face_gradients(mesh, g, f, G, area);
+    face_gradients(g, f, G, area);
     if (!options_.face_weights.empty()) area *= options_.face_weights[f];
     const Eigen::Vector2d u(std::cos(theta[f]), std::sin(theta[f])), v(-u.y(), u.x());
     const Eigen::Matrix3d Hf = area * G.transpose() * G;
@@ -634,7 +627,7 @@ double ParamSolver::optimal_field_rotation(const TriMesh& mesh, const GeometryCa
   return phi;
 }
 
-std::vector<double> face_energies(const TriMesh& mesh, const GeometryCache& g,
+std::vector<double> face_energies(const TriMesh& /*mesh*/, const GeometryCache& g,
                                   const std::vector<double>& theta,
                                   const std::vector<std::array<double, 2>>& uv,
                                   const ParamOptions& options,
@@ -647,7 +640,7 @@ std::vector<double> face_energies(const TriMesh& mesh, const GeometryCache& g,
   for (int f = 0; f < g.n_faces; ++f) {
     Eigen::Matrix<double, 2, 3> G;
     double area;
-    face_gradients(mesh, g, f, G, area);
+    face_gradients(g, f, G, area);
     const Eigen::Vector2d u(std::cos(theta[f]), std::sin(theta[f])), v(-u.y(), u.x());
     const double sf = log_scale.empty() ? 1.0 : std::exp(log_scale[f]);
     const Eigen::Vector3d cu(uv[3 * f][0], uv[3 * f + 1][0], uv[3 * f + 2][0]);
