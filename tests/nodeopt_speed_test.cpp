@@ -262,6 +262,38 @@ TEST(Relayout, CachedObstaclesMatchRebuiltOnes) {
   EXPECT_GT(kept, 10);
 }
 
+// NodeOptOptions::vertex_ordering: the optimizer's Pipelines carry one vertex order of the mesh
+// after the initial solve, and the descent takes the same steps to round-off as without it.
+TEST(Relayout, VertexOrderingKeepsTheDescent) {
+  const Example ex = ellipsoid_example();
+  const PipelineOptions options;
+  NodeOptOptions no;
+  no.max_steps = 6;
+  no.hop_polish = false;
+  no.orientation_at_end = false;
+  no.stiffen_at_end = false;
+  struct Recorder : Observer {
+    std::vector<StepReport> steps;
+    void on_step(const StepReport& r) override { steps.push_back(r); }
+  } ordered, plain;
+  NodeOptStats stats;
+  const NodeOptResult a =
+      optimize_nodes(ex.mesh, ex.layout, options, no, &ordered, nullptr, &stats);
+  no.vertex_ordering = false;
+  const NodeOptResult b = optimize_nodes(ex.mesh, ex.layout, options, no, &plain);
+  EXPECT_GT(stats.relayouts, 0);
+  ASSERT_TRUE(a.pipeline && b.pipeline);
+  ASSERT_TRUE(a.pipeline->options().param.vertex_order);
+  EXPECT_EQ(a.pipeline->options().param.vertex_order->size(), ex.mesh.n_vertices());
+  EXPECT_FALSE(b.pipeline->options().param.vertex_order);
+  EXPECT_EQ(a.E_init, b.E_init);  // the initial solve keeps CHOLMOD's ordering
+  ASSERT_EQ(ordered.steps.size(), plain.steps.size());
+  for (size_t k = 0; k < plain.steps.size(); ++k) {
+    EXPECT_EQ(ordered.steps[k].accepted, plain.steps[k].accepted) << "step " << k;
+    EXPECT_NEAR(ordered.steps[k].E, plain.steps[k].E, 1e-9 * plain.steps[k].E) << "step " << k;
+  }
+}
+
 // The optimizer with continued Pipelines: on the bundled example the descent accepts and
 // rejects the same steps as with a fresh Pipeline per trial and ends at nearly the same E
 // (the continued field keeps the start geometry's constraint set, a fresh one recomputes the

@@ -180,6 +180,41 @@ TEST(Parameterization, WedgeOrderingIsUsedAndGivesTheSameSolution) {
   EXPECT_NEAR(a.param->result().energy, b.param->result().energy, 1e-9 * a.param->result().energy);
 }
 
+// ParamOptions::vertex_order: the analysis takes the vertex order expanded to the unknowns
+// (a hinted analysis), and the solution is CHOLMOD's ordering's up to round-off; an order of
+// another size is not used.
+TEST(Parameterization, VertexOrderIsUsedAndGivesTheSameSolution) {
+  for (const auto& in : {test::cube_sphere(8), test::torus_grid(32, 16, 4, 2)}) {
+    const GeometryCache g = build_geometry(in.mesh);
+    const std::vector<int> order = vertex_nested_dissection(g);
+    ASSERT_EQ(order.size(), static_cast<size_t>(g.n_vertices));
+    std::vector<int> sorted = order;
+    std::sort(sorted.begin(), sorted.end());
+    for (int k = 0; k < g.n_vertices; ++k) ASSERT_EQ(sorted[k], k) << "not a permutation";
+    ParamOptions ordered, wrong;
+    ordered.vertex_order = std::make_shared<const std::vector<int>>(order);
+    wrong.vertex_order = std::make_shared<const std::vector<int>>(order.begin(), order.end() - 1);
+    const Solved a = solve_all(in), b = solve_all(in, ordered), c = solve_all(in, wrong);
+    EXPECT_EQ(a.param->linear_solver().stats().hinted_analyses, 0);
+    EXPECT_EQ(b.param->linear_solver().stats().hinted_analyses, 1);
+    EXPECT_EQ(c.param->linear_solver().stats().hinted_analyses, 0);
+    EXPECT_EQ(c.param->result().corner_uv, a.param->result().corner_uv);
+    const auto& ua = a.param->result().corner_uv;
+    const auto& ub = b.param->result().corner_uv;
+    ASSERT_EQ(ua.size(), ub.size());
+    double worst = 0, scale = 0;
+    for (size_t k = 0; k < ua.size(); ++k)
+      for (int j = 0; j < 2; ++j) {
+        worst = std::max(worst, std::abs(ua[k][j] - ub[k][j]));
+        scale = std::max(scale, std::abs(ua[k][j]));
+      }
+    EXPECT_GT(scale, 0);
+    EXPECT_LT(worst, 1e-9 * scale);
+    EXPECT_NEAR(a.param->result().energy, b.param->result().energy,
+                1e-9 * a.param->result().energy);
+  }
+}
+
 // ParamOptions::second_thread (labels beside the cut graph, the analysis beside the assembly)
 // changes nothing in the results: bit-identical corner values, energy and labels, with and
 // without the sizing field (its solve is part of the assembly the analysis overlaps).

@@ -199,6 +199,62 @@ TEST(SpdSolver, GroupedAmdOrderingIsUsedAndGivesTheSameSolution) {
   EXPECT_TRUE(grouped_amd_ordering(A, bad).empty());
 }
 
+// nested_dissection_ordering: a permutation whose last nodes (the top-level separator) cut a
+// grid graph in two; as a hint it gives the default ordering's solution. Input that does not
+// describe a graph gives no ordering.
+TEST(SpdSolver, NestedDissectionOrdersAGridGraph) {
+  const int n = 40;
+  const auto A = grid_matrix(n, 0.5);
+  const int size = static_cast<int>(A.rows());
+  std::vector<int> start(size + 1, 0), adjacency;
+  for (int c = 0; c < size; ++c) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(A, c); it; ++it)
+      if (it.row() != c) adjacency.push_back(static_cast<int>(it.row()));
+    start[c + 1] = static_cast<int>(adjacency.size());
+  }
+  const std::vector<int> order = nested_dissection_ordering(size, start, adjacency);
+  ASSERT_EQ(order.size(), static_cast<size_t>(size));
+  std::vector<int> sorted = order;
+  std::sort(sorted.begin(), sorted.end());
+  for (int k = 0; k < size; ++k) ASSERT_EQ(sorted[k], k) << "not a permutation";
+  // Without the last 2n nodes of the order the grid falls apart: the first separator is
+  // eliminated last.
+  std::vector<char> removed(size, 0);
+  for (int k = size - 2 * n; k < size; ++k) removed[order[k]] = 1;
+  std::vector<int> component(size, -1);
+  int components = 0;
+  for (int v = 0; v < size; ++v) {
+    if (removed[v] || component[v] >= 0) continue;
+    std::vector<int> stack{v};
+    component[v] = components;
+    while (!stack.empty()) {
+      const int u = stack.back();
+      stack.pop_back();
+      for (int q = start[u]; q < start[u + 1]; ++q) {
+        const int w = adjacency[q];
+        if (!removed[w] && component[w] < 0) component[w] = components, stack.push_back(w);
+      }
+    }
+    ++components;
+  }
+  EXPECT_GE(components, 2);
+  const Eigen::VectorXd b = random_vector(size, 9);
+  SpdSolver hinted("hinted"), reference("reference");
+  hinted.set_ordering_hint(order);
+  hinted.factorize(A);
+  EXPECT_EQ(hinted.stats().hinted_analyses, 1);
+  reference.factorize(A);
+  const Eigen::VectorXd xh = hinted.solve(b), xr = reference.solve(b);
+  EXPECT_LT(relative_residual(A, xh, b), 1e-10);
+  EXPECT_LT((xh - xr).norm(), 1e-9 * xr.norm());
+  // Not a graph: no ordering.
+  EXPECT_TRUE(nested_dissection_ordering(size, std::vector<int>(size, 0), adjacency).empty());
+  std::vector<int> bad = adjacency;
+  bad[5] = size;
+  EXPECT_TRUE(nested_dissection_ordering(size, start, bad).empty());
+  EXPECT_TRUE(nested_dissection_ordering(0, {0}, {}).empty());
+}
+
 // A copy shares the factorization until unshare(): then both solve on two threads at the same
 // time (run under TSan in CI) with the original's results, and refactorizing one leaves the
 // other's factorization alone.

@@ -472,6 +472,38 @@ void SpdSolver::set_ordering_hint(std::vector<int> ordering) {
   ordering_hint_ = std::move(ordering);
 }
 
+std::vector<int> nested_dissection_ordering(int n, const std::vector<int>& start,
+                                            const std::vector<int>& adjacency) {
+  if (n <= 0 || start.size() != static_cast<size_t>(n) + 1 || start[0] != 0 ||
+      start[n] != static_cast<int>(adjacency.size()))
+    return {};
+  for (int v = 0; v < n; ++v)
+    if (start[v + 1] < start[v]) return {};
+  for (int w : adjacency)
+    if (w < 0 || w >= n) return {};
+  cholmod_common c;
+  cholmod_start(&c);
+  c.print = 0;
+  // CHOLMOD reads the upper triangle of a symmetric pattern (stype 1): the lower entries of the
+  // both-ways adjacency are ignored.
+  cholmod_sparse G{};
+  G.nrow = G.ncol = static_cast<size_t>(n);
+  G.nzmax = std::max<size_t>(adjacency.size(), 1);
+  G.p = const_cast<int*>(start.data());
+  G.i = const_cast<int*>(adjacency.data());
+  G.stype = 1;
+  G.itype = CHOLMOD_INT;
+  G.xtype = CHOLMOD_PATTERN;
+  G.dtype = CHOLMOD_DOUBLE;
+  G.sorted = 0;
+  G.packed = 1;
+  std::vector<int> perm(n);
+  const int ok = cholmod_metis(&G, nullptr, 0, /*postorder=*/0, perm.data(), &c);
+  cholmod_finish(&c);
+  if (!ok) return {};
+  return perm;
+}
+
 std::vector<int> grouped_amd_ordering(const Eigen::SparseMatrix<double>& A,
                                       const std::vector<int>& group) {
   const int n = static_cast<int>(A.cols());

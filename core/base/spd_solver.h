@@ -124,6 +124,15 @@ class SpdSolver {
 std::vector<int> grouped_amd_ordering(const Eigen::SparseMatrix<double>& A,
                                       const std::vector<int>& group);
 
+//! A nested-dissection ordering (METIS, through CHOLMOD) of the undirected graph with \p n
+//! nodes whose neighbours of node v are adjacency[start[v] .. start[v + 1]) (both directions
+//! listed, no self loops). For orderings of unknowns that live on a mesh's vertices, expanded
+//! from the vertex graph's once instead of ordering every new matrix (ParamOptions::vertex_order).
+//! \return a permutation of 0..n−1 (entry k: the node eliminated k-th); empty when \p start
+//! does not fit or METIS fails.
+std::vector<int> nested_dissection_ordering(int n, const std::vector<int>& start,
+                                            const std::vector<int>& adjacency);
+
 //! A solver with set_full_storage(true), for matrices that store both triangles.
 inline SpdSolver full_storage_solver(std::string stage) {
   SpdSolver solver(std::move(stage));

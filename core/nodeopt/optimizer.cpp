@@ -167,7 +167,9 @@ std::vector<int> movable_nodes(const TriMesh& mesh, const Layout& layout) {
 
 // The optimization's state between units (NodeOptimizer::step), and the units themselves.
 struct NodeOptimizer::Impl {
-  const PipelineOptions options;
+  // The caller's; after the initial solve with NodeOptOptions::vertex_ordering, plus the vertex
+  // order that every later Pipeline uses.
+  PipelineOptions options;
   const NodeOptOptions no;
   const std::chrono::steady_clock::time_point t_start = std::chrono::steady_clock::now();
   const TriMesh original;        // the input positions (each relocated vertex lies on this surface)
@@ -231,6 +233,12 @@ struct NodeOptimizer::Impl {
     compute_movable();
     for (int n : movable) result.sliding_nodes += on_curve(state.layout.nodes[n].vertex);
     check_cancel(observer);
+    // The vertex order depends on the connectivity only: computed beside the initial solve (the
+    // future waits in its destructor if that throws).
+    std::future<std::vector<int>> vertex_order;
+    if (no.vertex_ordering && !options.param.vertex_order)
+      vertex_order = std::async(std::launch::async,
+                                [this] { return vertex_nested_dissection(original_geometry); });
     if (start && pipeline_matches(*start, mesh, layout)) {
       current.pipeline = std::move(start);
       current.E = unweighted_energy(current.pipeline->mesh(), current.pipeline->geometry(),
@@ -241,6 +249,13 @@ struct NodeOptimizer::Impl {
     } else {
       current = evaluate_fresh(state.mesh, state.layout, options, true);
       ++counters.fresh_pipelines;
+    }
+    if (vertex_order.valid()) {
+      std::vector<int> order = vertex_order.get();
+      if (!order.empty()) {
+        options.param.vertex_order = std::make_shared<const std::vector<int>>(std::move(order));
+        current.pipeline->set_param_vertex_order(options.param.vertex_order);
+      }
     }
     fewest_folds_count = current.foldovers;
     result.E_init = current.E;

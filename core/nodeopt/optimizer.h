@@ -110,6 +110,13 @@ struct NodeOptOptions {
   //! itself) both end at E 1.496 with 0 fold-overs.
   //! `optimize --integer` turns it off (nodes on shared iso-lines, see cmd_optimize.cpp).
   bool reuse_field = true;
+  //! The parameterizations of the trials take their fill-reducing ordering from one nested
+  //! dissection of the mesh's vertex graph (ParamOptions::vertex_order), computed beside the
+  //! initial solve, instead of an AMD ordering of every new reduced matrix. The initial solve
+  //! keeps AMD. Bunny (70K faces, 150 patches): the analysis of a re-layout takes about half the
+  //! time and each factorization about 20 % less (docs/benchmarks.md, session 22). Without
+  //! effect when the given PipelineOptions already carry a vertex order.
+  bool vertex_ordering = true;
   //! Polish by discrete hops (discrete.h hop_sweep) when the descent ends (no node moves, more
   //! than max_halvings halvings, or the step budget is used up): the descent can stop in a local
   //! optimum of E for the node carried by its current (relocated) vertex, which a hop to a

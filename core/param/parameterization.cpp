@@ -5,6 +5,8 @@
 #include <chrono>
 #include <cmath>
 #include <future>
+#include <limits>
+#include <numeric>
 #include <sstream>
 #include <unordered_map>
 #include <utility>
@@ -350,6 +352,10 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
   result_.eliminated = reduction_.eliminated;
   result_.redundant = reduction_.redundant;
   result_.unknowns = static_cast<int>(reduction_.Z.cols());
+  n_vertices_ = g.n_vertices;
+  wedge_vertex_.assign(cut_.wedges, -1);
+  for (int c = 0; c < 3 * g.n_faces; ++c)
+    wedge_vertex_[cut_.corner_wedge[c]] = g.face_vertices[c / 3][c % 3];
   result_.timings.setup_s = seconds_since(t0);
   if (previous && previous != this) {
     std::swap(solver_, previous->solver_);
@@ -425,9 +431,58 @@ void ParamSolver::begin_analysis() {
 }
 
 void ParamSolver::hint_ordering(const Eigen::SparseMatrix<double>& A) {
-  if (!options_.wedge_ordering || solver_.same_pattern(A)) return;
+  if (!(options_.wedge_ordering || options_.vertex_order) || solver_.same_pattern(A)) return;
+  if (options_.vertex_order) {
+    std::vector<int> hint = vertex_order_hint(A);
+    if (!hint.empty()) {
+      solver_.set_ordering_hint(std::move(hint));
+      return;
+    }
+  }
+  if (!options_.wedge_ordering) return;
   solver_.set_ordering_hint(grouped_amd_ordering(
       A, parameterization_groups(cut_.wedges, reduction_.free_index, static_cast<int>(A.cols()))));
+}
+
+std::vector<int> ParamSolver::vertex_order_hint(const Eigen::SparseMatrix<double>& A) const {
+  const std::vector<int>& order = *options_.vertex_order;
+  const int m = static_cast<int>(A.cols());
+  if (order.size() != static_cast<size_t>(n_vertices_) || reduction_.Z.cols() != m) return {};
+  std::vector<int> rank(n_vertices_, -1);
+  for (int k = 0; k < n_vertices_; ++k) {
+    if (order[k] < 0 || order[k] >= n_vertices_ || rank[order[k]] >= 0) return {};
+    rank[order[k]] = k;
+  }
+  // A wedge unknown's column holds its face neighbours' (about 7 entries; about 3 times that
+  // where the cut's transitions merged the wedges on both sides of a seam). Longer columns (an
+  // arc's node-connection unknowns, the seam translations) couple distant vertices: last, as
+  // AMD orders dense rows.
+  constexpr int kLongColumn = 48;
+  constexpr long kLast = std::numeric_limits<long>::max();
+  std::vector<long> place(m, kLast);
+  const int wedge_variables =
+      std::min(2 * cut_.wedges, static_cast<int>(reduction_.free_index.size()));
+  for (int i = 0; i < wedge_variables; ++i) {
+    const int a = reduction_.free_index[i];
+    if (a >= 0 && A.outerIndexPtr()[a + 1] - A.outerIndexPtr()[a] <= kLongColumn)
+      place[a] = rank[wedge_vertex_[i / 2]];
+  }
+  std::vector<int> hint(m);
+  std::iota(hint.begin(), hint.end(), 0);
+  std::stable_sort(hint.begin(), hint.end(), [&](int a, int b) { return place[a] < place[b]; });
+  return hint;
+}
+
+std::vector<int> vertex_nested_dissection(const GeometryCache& g) {
+  std::vector<int> start(g.n_vertices + 1, 0), adjacency(2 * static_cast<size_t>(g.n_edges));
+  for (const auto& [a, b] : g.edge_vertices) ++start[a + 1], ++start[b + 1];
+  for (int v = 0; v < g.n_vertices; ++v) start[v + 1] += start[v];
+  std::vector<int> next(start.begin(), start.end() - 1);
+  for (const auto& [a, b] : g.edge_vertices) {
+    adjacency[next[a]++] = b;
+    adjacency[next[b]++] = a;
+  }
+  return nested_dissection_ordering(g.n_vertices, start, adjacency);
 }
 
 std::vector<double> ParamSolver::target_scales(const TriMesh& mesh, const GeometryCache& g,

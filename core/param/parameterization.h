@@ -49,6 +49,15 @@ struct ParamOptions {
   //! was higher on three of four meshes tried (bunny +5 %, joint +10 %, bunny with another
   //! layout +13 %; spot −1 %) and the factorization up to 5 % slower, so it is off.
   bool wedge_ordering = false;
+  //! A fill-reducing order of the mesh's vertices (vertex_nested_dissection: entry k is the
+  //! vertex eliminated k-th, size #V), or null. When set, a new reduced matrix's symbolic
+  //! analysis takes its ordering from it (each unknown at its wedge's vertex, in that order; seam
+  //! translations and the long columns of merged unknowns last) instead of AMD on the matrix.
+  //! The vertex order does not depend on the layout, so the node optimizer computes it once for
+  //! all its layouts (NodeOptOptions::vertex_ordering). Bunny, 70K faces, 150 patches: flops of
+  //! a factorization −38 %, its time −20 %, the analysis −50 %; on the joint (3751 nodes)
+  //! nnz(L) +8 % (docs/benchmarks.md, session 22). Takes precedence over wedge_ordering.
+  std::shared_ptr<const std::vector<int>> vertex_order;
   //! Runs independent parts of the stage on a second thread: the layout labels beside the cut
   //! graph (construction), and a symbolic analysis of the reduced matrix (a new pattern: a fresh
   //! solver, another layout) beside the energy assembly, which it cannot disturb: the analysis
@@ -181,13 +190,23 @@ class ParamSolver {
                                                    const GeometryCache& geometry,
                                                    const Layout& layout,
                                                    const std::vector<double>& theta);
-  //! With ParamOptions::wedge_ordering, hands the wedge-graph ordering of \p A to the linear
-  //! solver when its next factorization analyzes (A's pattern is not the analyzed one).
+  //! Hands the linear solver an ordering for its next analysis when \p A's pattern is not the
+  //! analyzed one: ParamOptions::vertex_order expanded to A's unknowns, else with
+  //! ParamOptions::wedge_ordering the wedge-graph ordering of A; else CHOLMOD chooses.
   void hint_ordering(const Eigen::SparseMatrix<double>& A);
+  //! ParamOptions::vertex_order expanded to the unknowns of \p A (a permutation), or empty when
+  //! it does not fit this mesh.
+  std::vector<int> vertex_order_hint(const Eigen::SparseMatrix<double>& A) const;
+  std::vector<int> wedge_vertex_;  //!< per wedge: its vertex (from the cut graph's corners)
+  int n_vertices_ = 0;
   //! With ParamOptions::second_thread: starts the analysis of A's pattern on the second thread
   //! (SpdSolver::begin_analysis; a no-op for the analyzed pattern), hint included.
   void begin_analysis();
 };
+
+//! A nested-dissection order of \p geometry's vertices (their edge graph) for
+//! ParamOptions::vertex_order; empty when METIS fails (the solvers then use AMD).
+std::vector<int> vertex_nested_dissection(const GeometryCache& geometry);
 
 //! Energy (1) per face for given corner values (same conventions as the solver), without
 //! ParamOptions::face_weights. \p log_scale: the targets' per-face log-scale s_t

@@ -98,6 +98,12 @@ class Pipeline {
   //! rotation's solver of a fresh field, or the one set up beside update_layout), not built
   //! after the field.
   bool param_solver_prepared() const { return param_prepared_; }
+  //! Sets ParamOptions::vertex_order for the parameterization solvers built from now on, here
+  //! and in the Pipelines continued from this one (the current solver keeps its analysis).
+  void set_param_vertex_order(std::shared_ptr<const std::vector<int>> order) {
+    options_.param.vertex_order = std::move(order);
+  }
+  const PipelineOptions& options() const { return options_; }
   //! Traces the arcs on the current parameterization.
   const Extraction& extract();
   //! Metrics of the current parameterization (curvature computed once).
