@@ -182,6 +182,11 @@ TEST(Routing, ShortestPathFollowsEdgesAndAvoidsObstacles) {
   o = no_obstacles(g.mesh);
   for (const int b : {g.v(0, 1), g.v(1, 1), g.v(1, 0)}) o.vertex_blocked[b] = 1;
   EXPECT_TRUE(shortest_path(g.mesh, g.v(0, 0), g.v(5, 5), o).empty());
+  EXPECT_TRUE(shortest_path(g.mesh, g.v(5, 5), g.v(0, 0), o).empty());  // the target enclosed
+  // A blocked vertex next to the enclosed corner is a reachable target from either side.
+  EXPECT_EQ(shortest_path(g.mesh, g.v(0, 0), g.v(1, 0), o),
+            (std::vector<int>{g.v(0, 0), g.v(1, 0)}));
+  EXPECT_FALSE(shortest_path(g.mesh, g.v(5, 5), g.v(1, 0), o).empty());
   EXPECT_TRUE(shortest_path(g.mesh, -1, g.v(5, 5), o).empty());
   EXPECT_TRUE(shortest_path(g.mesh, 0, 1000, o).empty());
   // Obstacle vectors of the wrong size do not crash.
