@@ -233,6 +233,36 @@ TEST(OrientationParam, DenseDualAndSparsePrimalSolversAgree) {
   EXPECT_LT(worst, 1e-4);
 }
 
+// ParamOptions::vertex_order also orders the sparse rounds' normal matrices: the same
+// constrained optimum as with CHOLMOD's own ordering, to the solver's tolerance.
+TEST(OrientationParam, VertexOrderGivesTheSameSparseSolve) {
+  const auto in = test::cube_sphere(6);
+  const Layout layout = displaced(in, 3, 2);
+  PipelineOptions plain_options = with_orientation(0);
+  plain_options.param.orientation.all_faces_after_rounds = 0;
+  PipelineOptions ordered_options = plain_options;
+  ordered_options.param.vertex_order =
+      std::make_shared<const std::vector<int>>(vertex_nested_dissection(build_geometry(in.mesh)));
+  ASSERT_EQ(ordered_options.param.vertex_order->size(), in.mesh.n_vertices());
+  Pipeline plain(in.mesh, layout, plain_options), ordered(in.mesh, layout, ordered_options);
+  const Parameterization& a = plain.compute_parameterization();
+  const Parameterization& b = ordered.compute_parameterization();
+  ASSERT_GT(a.orientation.foldovers_before, 0);
+  EXPECT_FALSE(b.orientation.dense);
+  EXPECT_GT(b.orientation.sparse_factorizations, 0);
+  EXPECT_EQ(ordered.param_solver()->linear_solver().stats().hinted_analyses, 1);
+  EXPECT_EQ(a.orientation.ordered_rounds, 0);
+  EXPECT_EQ(b.orientation.ordered_rounds, b.orientation.rounds);
+  EXPECT_EQ(a.foldovers, 0);
+  EXPECT_EQ(b.foldovers, 0);
+  EXPECT_NEAR(a.energy, b.energy, 1e-7 * a.energy);
+  double worst = 0;
+  for (size_t c = 0; c < a.corner_uv.size(); ++c)
+    for (int k = 0; k < 2; ++k)
+      worst = std::max(worst, std::abs(a.corner_uv[c][k] - b.corner_uv[c][k]));
+  EXPECT_LT(worst, 1e-4);
+}
+
 // OrientationOptions::observer is polled inside the solve, by both solvers: an observer that
 // asks to cancel after k polls stops it with qs::Cancelled (no result, no SolverError), and one
 // that never does sees at least one poll per interior-point iteration.

@@ -247,6 +247,7 @@ class NormalMatrix {
 struct IpmOutcome {
   bool converged = false;
   bool infeasible = false;
+  bool ordered = false;  // the normal matrix's analysis used the given ordering
   int iterations = 0;
   double primal_residual = 0;
 };
@@ -254,11 +255,12 @@ struct IpmOutcome {
 IpmOutcome interior_point(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
                           const Eigen::SparseMatrix<double>& C, const Eigen::VectorXd& d,
                           Eigen::VectorXd& y, int max_iterations, double tol,
-                          const Observer* observer) {
+                          const Observer* observer, const std::vector<int>* ordering) {
   IpmOutcome out;
   const int m = static_cast<int>(C.rows());
   const Eigen::SparseMatrix<double> Ct = C.transpose();
   SpdSolver solver("orientation constraints");
+  if (ordering && !ordering->empty()) solver.set_ordering_hint(*ordering);
   NormalMatrix normal(A, C, kRowsPerFace);
   Eigen::VectorXd s = (C * y - d).cwiseMax(1.0);
   Eigen::VectorXd lambda = Eigen::VectorXd::Ones(m);
@@ -268,6 +270,7 @@ IpmOutcome interior_point(const Eigen::SparseMatrix<double>& A, const Eigen::Vec
   // the normal matrix loses positive definiteness to rounding.
   auto factorize = [&]() {
     solver.factorize(normal.assemble(lambda.cwiseQuotient(s).cwiseMin(1e10)));
+    out.ordered = solver.stats().hinted_analyses > 0;
   };
   // Direction for complementarity target r_c (Λ Δs + S Δλ = r_c).
   auto direction = [&](const Eigen::VectorXd& rd, const Eigen::VectorXd& rp,
@@ -487,7 +490,8 @@ Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& g,
                                const std::vector<int>& corner_wedge, const Reduction& red,
                                const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
                                const Eigen::VectorXd& y0, const OrientationOptions& o,
-                               OrientationReport* report, SpdSolver* factorized_A) {
+                               OrientationReport* report, SpdSolver* factorized_A,
+                               const std::vector<int>* ordering) {
   const auto t0 = std::chrono::steady_clock::now();
   OrientationReport local;
   OrientationReport& rep = report ? *report : local;
@@ -553,8 +557,10 @@ Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& g,
                                 o.observer);
       y = y0 + h * (W * lambda);
     } else {
-      ipm = interior_point(As, bs, rows.C, rows.d, y, o.max_iterations, o.tolerance, o.observer);
+      ipm = interior_point(As, bs, rows.C, rows.d, y, o.max_iterations, o.tolerance, o.observer,
+                           ordering);
       rep.sparse_factorizations += ipm.iterations;
+      rep.ordered_rounds += ipm.ordered;
     }
     rep.iterations += ipm.iterations;
     if (ipm.infeasible) rep.infeasible_faces = most_violated_faces(rows, y, kNamedFaces);

@@ -102,12 +102,14 @@ struct OrientationReport {
   //! The result was used: it has fewer fold-overs than before (set by ParamSolver::solve).
   bool success = false;
   int foldovers_before = 0, foldovers_after = 0;
-  int constrained_faces = 0;                   //!< |S| in the last round
-  int skipped_faces = 0;                       //!< faces of S left out: degenerate 3D triangle
-  bool all_faces = false;                      //!< the last round constrained every face
-  int rounds = 0;                              //!< QP solves
-  int iterations = 0;                          //!< interior-point iterations in total
-  int sparse_factorizations = 0;               //!< CHOLMOD factorizations (primal solver only)
+  int constrained_faces = 0;      //!< |S| in the last round
+  int skipped_faces = 0;          //!< faces of S left out: degenerate 3D triangle
+  bool all_faces = false;         //!< the last round constrained every face
+  int rounds = 0;                 //!< QP solves
+  int iterations = 0;             //!< interior-point iterations in total
+  int sparse_factorizations = 0;  //!< CHOLMOD factorizations (primal solver only)
+  //! sparse rounds whose normal matrices took the given ordering (solve_oriented's \p ordering)
+  int ordered_rounds = 0;
   bool dense = false;                          //!< the last round used the dense dual solver
   double energy_before = 0, energy_after = 0;  //!< value of the (weighted) energy (1)
   double time_s = 0;
@@ -131,13 +133,17 @@ std::vector<std::array<std::array<double, 2>, 3>> ideal_corner_offsets(
 //! node of very high valence, faces that the equality constraints force to fold) in the first
 //! round. When a later round (a grown set) is infeasible, the earlier round with the fewest
 //! fold-overs is returned and report->message says so.
+//! \p ordering, when given and not empty: the fill-reducing ordering of y's unknowns for the
+//! sparse rounds' normal matrices (a permutation, SpdSolver::set_ordering_hint; the
+//! parameterization passes its ParamOptions::vertex_order expanded), instead of AMD per round.
 Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& geometry,
                                const std::vector<double>& theta,
                                const std::vector<int>& corner_wedge, const Reduction& reduction,
                                const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
                                const Eigen::VectorXd& y0, const OrientationOptions& options,
                                OrientationReport* report = nullptr,
-                               SpdSolver* factorized_A = nullptr);
+                               SpdSolver* factorized_A = nullptr,
+                               const std::vector<int>* ordering = nullptr);
 
 //! Fold-overs (signed parametric area ≤ 0) of x = Z·y + z0. Size-#F flags in \p folded if given.
 int count_foldovers(const std::vector<int>& corner_wedge, const Eigen::VectorXd& x,

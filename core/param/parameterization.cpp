@@ -576,8 +576,12 @@ const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCa
     // solution stays and the report says why.
     OrientationReport& rep = result_.orientation;
     try {
+      // The normal matrices of its sparse rounds hold A's pattern and face couplings: the vertex
+      // order fits them as it fits A.
+      const std::vector<int> ordering =
+          options_.vertex_order ? vertex_order_hint(A) : std::vector<int>{};
       const Eigen::VectorXd yo = solve_oriented(mesh, g, theta, cut_.corner_wedge, reduction_, A, b,
-                                                y, options_.orientation, &rep, &solver_);
+                                                y, options_.orientation, &rep, &solver_, &ordering);
       rep.energy_before = energy_of(y);
       rep.energy_after = energy_of(yo);
       if (rep.foldovers_after < rep.foldovers_before) {
