@@ -262,20 +262,28 @@ TEST(Relayout, CachedObstaclesMatchRebuiltOnes) {
   EXPECT_GT(kept, 10);
 }
 
+// \p steps descent steps, nothing after them (no hop polish, no fold-over removal).
+NodeOptOptions descent_only(int steps) {
+  NodeOptOptions no;
+  no.max_steps = steps;
+  no.hop_polish = false;
+  no.orientation_at_end = false;
+  no.stiffen_at_end = false;
+  return no;
+}
+
+struct StepRecorder : Observer {
+  std::vector<StepReport> steps;
+  void on_step(const StepReport& r) override { steps.push_back(r); }
+};
+
 // NodeOptOptions::vertex_ordering: the optimizer's Pipelines carry one vertex order of the mesh
 // after the initial solve, and the descent takes the same steps to round-off as without it.
 TEST(Relayout, VertexOrderingKeepsTheDescent) {
   const Example ex = ellipsoid_example();
   const PipelineOptions options;
-  NodeOptOptions no;
-  no.max_steps = 6;
-  no.hop_polish = false;
-  no.orientation_at_end = false;
-  no.stiffen_at_end = false;
-  struct Recorder : Observer {
-    std::vector<StepReport> steps;
-    void on_step(const StepReport& r) override { steps.push_back(r); }
-  } ordered, plain;
+  NodeOptOptions no = descent_only(6);
+  StepRecorder ordered, plain;
   NodeOptStats stats;
   const NodeOptResult a =
       optimize_nodes(ex.mesh, ex.layout, options, no, &ordered, nullptr, &stats);
@@ -301,16 +309,9 @@ TEST(Relayout, VertexOrderingKeepsTheDescent) {
 TEST(Relayout, OptimizerMatchesFreshTrialsOnExample) {
   const Example ex = ellipsoid_example();
   const PipelineOptions options;
-  NodeOptOptions no;
+  NodeOptOptions no = descent_only(10);
   no.reuse_field = true;  // the continued path (off by default), against fresh pipelines
-  no.max_steps = 10;
-  no.hop_polish = false;
-  no.orientation_at_end = false;
-  no.stiffen_at_end = false;
-  struct Recorder : Observer {
-    std::vector<StepReport> steps;
-    void on_step(const StepReport& r) override { steps.push_back(r); }
-  } with_reuse, without;
+  StepRecorder with_reuse, without;
   NodeOptStats stats_reuse, stats_fresh;
   const NodeOptResult a =
       optimize_nodes(ex.mesh, ex.layout, options, no, &with_reuse, nullptr, &stats_reuse);

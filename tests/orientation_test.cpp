@@ -165,6 +165,16 @@ Layout displaced(const test::MeshAndLayout& in, int rings, unsigned seed) {
   return perturb_layout(in.mesh, in.layout, po).layout;
 }
 
+// Largest difference of a corner coordinate between two parameterizations of one mesh.
+double max_corner_difference(const Parameterization& a, const Parameterization& b) {
+  EXPECT_EQ(a.corner_uv.size(), b.corner_uv.size());
+  double worst = 0;
+  for (size_t c = 0; c < a.corner_uv.size() && c < b.corner_uv.size(); ++c)
+    for (int k = 0; k < 2; ++k)
+      worst = std::max(worst, std::abs(a.corner_uv[c][k] - b.corner_uv[c][k]));
+  return worst;
+}
+
 PipelineOptions with_orientation(int dense_max_rows = OrientationOptions{}.dense_max_rows) {
   PipelineOptions o;
   o.param.orientation.enabled = true;
@@ -226,11 +236,7 @@ TEST(OrientationParam, DenseDualAndSparsePrimalSolversAgree) {
   EXPECT_EQ(a.foldovers, 0);
   EXPECT_EQ(b.foldovers, 0);
   EXPECT_NEAR(a.energy, b.energy, 1e-7 * a.energy);
-  double worst = 0;
-  for (size_t c = 0; c < a.corner_uv.size(); ++c)
-    for (int k = 0; k < 2; ++k)
-      worst = std::max(worst, std::abs(a.corner_uv[c][k] - b.corner_uv[c][k]));
-  EXPECT_LT(worst, 1e-4);
+  EXPECT_LT(max_corner_difference(a, b), 1e-4);
 }
 
 // ParamOptions::vertex_order also orders the sparse rounds' normal matrices: the same
@@ -256,11 +262,7 @@ TEST(OrientationParam, VertexOrderGivesTheSameSparseSolve) {
   EXPECT_EQ(a.foldovers, 0);
   EXPECT_EQ(b.foldovers, 0);
   EXPECT_NEAR(a.energy, b.energy, 1e-7 * a.energy);
-  double worst = 0;
-  for (size_t c = 0; c < a.corner_uv.size(); ++c)
-    for (int k = 0; k < 2; ++k)
-      worst = std::max(worst, std::abs(a.corner_uv[c][k] - b.corner_uv[c][k]));
-  EXPECT_LT(worst, 1e-4);
+  EXPECT_LT(max_corner_difference(a, b), 1e-4);
 }
 
 // OrientationOptions::observer is polled inside the solve, by both solvers: an observer that

@@ -472,6 +472,28 @@ void SpdSolver::set_ordering_hint(std::vector<int> ordering) {
   ordering_hint_ = std::move(ordering);
 }
 
+namespace {
+
+//! CHOLMOD's view of the symmetric pattern with \p n columns, rows \p row[start[c] ..
+//! start[c + 1]) in column c, of which CHOLMOD reads the upper triangle (stype 1): entries
+//! below the diagonal are ignored.
+cholmod_sparse upper_pattern(int n, const std::vector<int>& start, const std::vector<int>& row) {
+  cholmod_sparse a{};
+  a.nrow = a.ncol = static_cast<size_t>(n);
+  a.nzmax = row.size();
+  a.p = const_cast<int*>(start.data());
+  a.i = row.empty() ? nullptr : const_cast<int*>(row.data());
+  a.stype = 1;
+  a.itype = CHOLMOD_INT;
+  a.xtype = CHOLMOD_PATTERN;
+  a.dtype = CHOLMOD_DOUBLE;
+  a.sorted = 0;
+  a.packed = 1;
+  return a;
+}
+
+}  // namespace
+
 std::vector<int> nested_dissection_ordering(int n, const std::vector<int>& start,
                                             const std::vector<int>& adjacency) {
   if (n <= 0 || start.size() != static_cast<size_t>(n) + 1 || start[0] != 0 ||
@@ -481,23 +503,14 @@ std::vector<int> nested_dissection_ordering(int n, const std::vector<int>& start
     if (start[v + 1] < start[v]) return {};
   for (int w : adjacency)
     if (w < 0 || w >= n) return {};
+  std::vector<int> perm(n);
+  std::iota(perm.begin(), perm.end(), 0);
+  if (adjacency.empty()) return perm;  // no edges: any order is free of fill
   cholmod_common c;
   cholmod_start(&c);
   c.print = 0;
-  // CHOLMOD reads the upper triangle of a symmetric pattern (stype 1): the lower entries of the
-  // both-ways adjacency are ignored.
-  cholmod_sparse G{};
-  G.nrow = G.ncol = static_cast<size_t>(n);
-  G.nzmax = std::max<size_t>(adjacency.size(), 1);
-  G.p = const_cast<int*>(start.data());
-  G.i = const_cast<int*>(adjacency.data());
-  G.stype = 1;
-  G.itype = CHOLMOD_INT;
-  G.xtype = CHOLMOD_PATTERN;
-  G.dtype = CHOLMOD_DOUBLE;
-  G.sorted = 0;
-  G.packed = 1;
-  std::vector<int> perm(n);
+  // The lower entries of the both-ways adjacency are ignored.
+  cholmod_sparse G = upper_pattern(n, start, adjacency);
   const int ok = cholmod_metis(&G, nullptr, 0, /*postorder=*/0, perm.data(), &c);
   cholmod_finish(&c);
   if (!ok) return {};
@@ -546,17 +559,7 @@ std::vector<int> grouped_amd_ordering(const Eigen::SparseMatrix<double>& A,
   cholmod_common c;
   cholmod_start(&c);
   c.print = 0;
-  cholmod_sparse Q{};
-  Q.nrow = Q.ncol = static_cast<size_t>(groups);
-  Q.nzmax = qi.size();
-  Q.p = qp.data();
-  Q.i = qi.empty() ? nullptr : qi.data();
-  Q.stype = 1;  // upper triangle
-  Q.itype = CHOLMOD_INT;
-  Q.xtype = CHOLMOD_PATTERN;
-  Q.dtype = CHOLMOD_DOUBLE;
-  Q.sorted = 0;
-  Q.packed = 1;
+  cholmod_sparse Q = upper_pattern(groups, qp, qi);
   std::vector<int> qperm(groups);
   const int ok = qi.empty() ? 1 : cholmod_amd(&Q, nullptr, 0, qperm.data(), &c);
   if (qi.empty()) std::iota(qperm.begin(), qperm.end(), 0);

@@ -273,15 +273,7 @@ struct NodeOptimizer::Impl {
 
   // Vertex c holds another node than n, or lies on an arc not incident to n.
   static bool occupied(const Layout& layout, int n, int c, const LayoutObstacles& obstacles) {
-    for (int m = 0; m < static_cast<int>(layout.nodes.size()); ++m)
-      if (m != n && layout.nodes[m].vertex == c) return true;
-    if (!obstacles.routing.vertex_blocked[c]) return false;
-    const int id = layout.nodes[n].id;
-    for (const auto& arc : layout.arcs)
-      if ((arc.from == id || arc.to == id) &&
-          std::find(arc.path.begin(), arc.path.end(), c) != arc.path.end())
-        return false;
-    return true;
+    return occupied_by_layout(layout, n, obstacles, c);
   }
 
   // A node on this vertex is on a curve: it slides along it while the curve goes on straight

@@ -150,21 +150,25 @@ std::vector<char> forbidden_relocation_vertices(const Layout& layout, int node_i
   return out;
 }
 
-bool relocation_forbidden(const Layout& layout, int node_index, const LayoutObstacles& obstacles,
-                          int v) {
-  // The order of forbidden_relocation_vertices' rules: other nodes' vertices last (always
-  // forbidden), then the node's own vertex and arcs (only when fixed), then every blocked one.
+bool occupied_by_layout(const Layout& layout, int node_index, const LayoutObstacles& obstacles,
+                        int v) {
   for (size_t n = 0; n < layout.nodes.size(); ++n)
     if (static_cast<int>(n) != node_index && layout.nodes[n].vertex == v) return true;
-  const bool fixed = obstacles.fixed[v] != 0;
-  if (v == layout.nodes[node_index].vertex) return fixed;
-  if (!obstacles.routing.vertex_blocked[v]) return fixed;
+  if (!obstacles.routing.vertex_blocked[v]) return false;
   const int id = layout.nodes[node_index].id;
   for (const auto& arc : layout.arcs)
     if ((arc.from == id || arc.to == id) &&
         std::find(arc.path.begin(), arc.path.end(), v) != arc.path.end())
-      return fixed;
+      return false;
   return true;
+}
+
+bool relocation_forbidden(const Layout& layout, int node_index, const LayoutObstacles& obstacles,
+                          int v) {
+  // forbidden_relocation_vertices: fixed or blocked vertices, except the node's own vertex and
+  // arcs when they are not fixed, and every other node's vertex.
+  if (obstacles.fixed[v] || v == layout.nodes[node_index].vertex) return obstacles.fixed[v] != 0;
+  return occupied_by_layout(layout, node_index, obstacles, v);
 }
 
 bool same_layout_structure(const LayoutTopology& a, const LayoutTopology& b) {
