@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "core/extract/tracing.h"
 #include "core/field/cross_field.h"
@@ -206,6 +207,21 @@ TEST(Parameterization, VertexOrderIsUsedAndGivesTheSameSolution) {
     expect_same_corners(a.param->result(), b.param->result(), 1e-9);
     EXPECT_NEAR(a.param->result().energy, b.param->result().energy,
                 1e-9 * a.param->result().energy);
+  }
+}
+
+// A geometry cache without the kept hat-function gradients (not made by build_geometry) is
+// refused with a message, not read out of bounds.
+TEST(Parameterization, GeometryWithoutFaceGradientsIsRefused) {
+  const auto in = test::cube_sphere(4);
+  const Solved s = solve_all(in);
+  GeometryCache broken = s.geometry;
+  broken.face_gradient.clear();
+  try {
+    ParamSolver solver(in.mesh, broken, in.layout, s.topology, s.field.period_jump, s.field.theta);
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("face gradients"), std::string::npos) << e.what();
   }
 }
 

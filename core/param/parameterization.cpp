@@ -93,6 +93,14 @@ void compact(Terms& t) {
 
 // Local 2D gradient operator of face f: ∇φ_k (2D, in the frame r_f, n×r_f), and the area
 // (GeometryCache::face_gradient).
+//! \throw InvalidInputError when \p g does not hold them (a cache not from build_geometry).
+void check_face_gradients(const GeometryCache& g) {
+  if (static_cast<int>(g.face_gradient.size()) != g.n_faces)
+    throw InvalidInputError("geometry cache has " + std::to_string(g.face_gradient.size()) +
+                            " face gradients for " + std::to_string(g.n_faces) +
+                            " faces (build it with build_geometry)");
+}
+
 void face_gradients(const GeometryCache& g, int f, Eigen::Matrix<double, 2, 3>& G, double& area) {
   const std::array<double, 7>& grad = g.face_gradient[f];
   for (int k = 0; k < 3; ++k) G.col(k) = Eigen::Vector2d(grad[2 * k], grad[2 * k + 1]);
@@ -530,6 +538,7 @@ const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCa
   assembly_.clear();
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
   double constant = 0;
+  check_face_gradients(g);
   for (int f = 0; f < g.n_faces; ++f) {
     Eigen::Matrix<double, 2, 3> G;
     double area;
@@ -613,6 +622,7 @@ double ParamSolver::optimal_field_rotation(const TriMesh& mesh, const GeometryCa
   const std::vector<double> scale = target_scales(mesh, g, theta);  // rotation-invariant s
   assembly_.clear();
   Eigen::VectorXd rhs0 = Eigen::VectorXd::Zero(n), rhs1 = Eigen::VectorXd::Zero(n);
+  check_face_gradients(g);
   for (int f = 0; f < g.n_faces; ++f) {
     Eigen::Matrix<double, 2, 3> G;
     double area;
@@ -696,6 +706,7 @@ std::vector<double> face_energies(const TriMesh& /*mesh*/, const GeometryCache& 
                             " sizing log-scales for " + std::to_string(g.n_faces) + " faces");
   const double aniso = options.anisotropic ? options.anisotropy : 1.0;
   std::vector<double> out(g.n_faces);
+  check_face_gradients(g);
   for (int f = 0; f < g.n_faces; ++f) {
     Eigen::Matrix<double, 2, 3> G;
     double area;
