@@ -222,9 +222,9 @@ TEST(Relayout, MovedNodesGiveTheFreshFieldTopology) {
                InvalidInputError);
 }
 
-// The cached obstacles of move_node_and_reroute give the same re-routed layouts and forbidden
-// vertex sets as rebuilding them per move (vertex by vertex too: relocation_forbidden), and
-// stay equal to obstacles_of_layout.
+// The cached obstacles of move_node_and_reroute give the same re-routed layouts as rebuilding
+// them per move, the same forbidden vertices (relocation_forbidden, vertex by vertex, against
+// the #V array built from the layout), and stay equal to obstacles_of_layout.
 TEST(Relayout, CachedObstaclesMatchRebuiltOnes) {
   const Example ex = ellipsoid_example();
   Layout slow = ex.layout, fast = ex.layout;
@@ -235,10 +235,8 @@ TEST(Relayout, CachedObstaclesMatchRebuiltOnes) {
   for (int round = 0; round < 6; ++round)
     for (int n = 0; n < static_cast<int>(slow.nodes.size()); ++n) {
       const auto forbidden_slow = forbidden_relocation_vertices(ex.mesh, slow, n);
-      const auto forbidden_fast = forbidden_relocation_vertices(fast, n, cache);
-      ASSERT_EQ(forbidden_slow, forbidden_fast) << "round " << round << " node " << n;
-      for (int v = 0; v < static_cast<int>(forbidden_fast.size()); ++v)
-        ASSERT_EQ(relocation_forbidden(fast, n, cache, v), forbidden_fast[v] != 0)
+      for (int v = 0; v < static_cast<int>(forbidden_slow.size()); ++v)
+        ASSERT_EQ(relocation_forbidden(fast, n, cache, v), forbidden_slow[v] != 0)
             << "round " << round << " node " << n << " vertex " << v;
       auto cand = test::ring_vertices(ex.mesh, slow.nodes[n].vertex, 1 + round % 2);
       std::shuffle(cand.begin(), cand.end(), rng);

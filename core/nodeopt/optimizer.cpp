@@ -271,11 +271,6 @@ struct NodeOptimizer::Impl {
     emit_step(r, state.mesh, state.layout, result.reports, observer);
   }
 
-  // Vertex c holds another node than n, or lies on an arc not incident to n.
-  static bool occupied(const Layout& layout, int n, int c, const LayoutObstacles& obstacles) {
-    return occupied_by_layout(layout, n, obstacles, c);
-  }
-
   // A node on this vertex is on a curve: it slides along it while the curve goes on straight
   // there (curves.slides), and stays on a curve end, junction or corner.
   bool on_curve(int vertex) const { return !curves.empty() && !curves.neighbours[vertex].empty(); }
@@ -329,7 +324,9 @@ struct NodeOptimizer::Impl {
     if (remaining < no.min_step_relative * mean_edge) return false;
     // Vertices the walk may not pass or take: other nodes and other arcs; it stops on a free
     // curve end, junction or corner (the node then sits on that vertex, which keeps its place).
-    auto occupied = [&](int c) { return c != v && this->occupied(trial.layout, n, c, obstacles); };
+    auto occupied = [&](int c) {
+      return c != v && occupied_by_layout(trial.layout, n, obstacles, c);
+    };
     // Walk: the point ends on segment (seq[k], seq[k+1]) at fraction s from seq[k].
     size_t k = 0;
     Vec3 from = start;
@@ -782,7 +779,7 @@ struct NodeOptimizer::Impl {
           }
           if (near >= 0 && near != v && on_curve(near) &&
               !original.is_boundary(original.vertex_handle(near)) &&
-              !occupied(trial.layout, n, near, obstacles) &&
+              !occupied_by_layout(trial.layout, n, obstacles, near) &&
               relocation_keeps_orientation(trial.mesh, original, v, near,
                                            original.point(original.vertex_handle(near)),
                                            no.relocation) &&

@@ -131,25 +131,6 @@ LayoutObstacles make_layout_obstacles(const TriMesh& mesh, const Layout& layout,
   return out;
 }
 
-std::vector<char> forbidden_relocation_vertices(const Layout& layout, int node_index,
-                                                const LayoutObstacles& obstacles) {
-  // Every arc and node vertex, except the node's own arcs (their vertices shared with other
-  // arcs are node vertices, re-marked below) and its own vertex.
-  std::vector<char> out = obstacles.fixed;
-  const std::vector<char>& blocked = obstacles.routing.vertex_blocked;
-  for (size_t v = 0; v < out.size(); ++v) out[v] |= blocked[v];
-  const int id = layout.nodes[node_index].id;
-  for (const auto& arc : layout.arcs) {
-    if (arc.from != id && arc.to != id) continue;
-    for (int v : arc.path) out[v] = obstacles.fixed[v];
-  }
-  const int own = layout.nodes[node_index].vertex;
-  out[own] = obstacles.fixed[own];
-  for (size_t n = 0; n < layout.nodes.size(); ++n)
-    if (static_cast<int>(n) != node_index) out[layout.nodes[n].vertex] = 1;
-  return out;
-}
-
 bool occupied_by_layout(const Layout& layout, int node_index, const LayoutObstacles& obstacles,
                         int v) {
   for (size_t n = 0; n < layout.nodes.size(); ++n)

@@ -110,17 +110,13 @@ int choose_relocation_vertex(const TriMesh& mesh, const TriMesh& original,
 //! (an index into layout.nodes).
 std::vector<char> forbidden_relocation_vertices(const TriMesh& mesh, const Layout& layout,
                                                 int node_index);
-//! The same from \p obstacles (make_layout_obstacles of \p layout): O(#V) and the node's own
-//! arcs instead of every arc path.
-std::vector<char> forbidden_relocation_vertices(const Layout& layout, int node_index,
-                                                const LayoutObstacles& obstacles);
 //! Vertex \p v holds another node than \p node_index, or lies on an arc not incident to it
 //! (\p obstacles: make_layout_obstacles of \p layout).
 bool occupied_by_layout(const Layout& layout, int node_index, const LayoutObstacles& obstacles,
                         int v);
-//! One entry of forbidden_relocation_vertices(layout, node_index, obstacles), vertex \p v,
-//! without building the #V array (a descent step asks for three vertices per node): occupied
-//! or fixed.
+//! One entry of forbidden_relocation_vertices for node \p node_index, vertex \p v, from
+//! \p obstacles (make_layout_obstacles of \p layout) without building the #V array (a descent
+//! step asks for three vertices per node): occupied, or fixed.
 bool relocation_forbidden(const Layout& layout, int node_index, const LayoutObstacles& obstacles,
                           int v);
 
