@@ -6,7 +6,13 @@
 // factorization after its own analysis, like the stage's). Not a test.
 //
 //   qs_param_bench --mesh M --layout L [--repeat N] [--detail] [--one-thread]
-//                  [--one-thread-trace] [--default-malloc]
+//                  [--one-thread-trace] [--default-malloc] [--no-vertex-order]
+//
+// The stage runs with the Pipeline's parameterization options: on meshes of at least 10 000
+// faces they carry the vertex order the Pipeline computed on its second thread beside the field
+// (PipelineOptions::order_vertices; its time is printed, it is not part of the stage), so the
+// stage's analysis is symbolic only. The unit keeps CHOLMOD's own AMD analysis (not timed) and
+// so its ordering. --no-vertex-order: AMD in the stage too, as before session 23.
 //
 // The allocator keeps freed memory for reuse, as quadsketch-cli and the GUI do
 // (keep_freed_memory, core/base/allocator.h); --default-malloc keeps glibc's defaults, under
@@ -108,12 +114,14 @@ int main(int argc, char** argv) {
   bool detail = false;
   bool second_thread = true;
   bool keep_memory = true;
+  bool vertex_order = true;
   qs::TraceOptions trace_options;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--detail")) detail = true;
     if (!std::strcmp(argv[i], "--one-thread")) second_thread = false;
     if (!std::strcmp(argv[i], "--one-thread-trace")) trace_options.second_thread_arcs = 0;
     if (!std::strcmp(argv[i], "--default-malloc")) keep_memory = false;
+    if (!std::strcmp(argv[i], "--no-vertex-order")) vertex_order = false;
   }
   // As quadsketch-cli and the GUI do (core/base/allocator.h): freed blocks are reused instead
   // of being page-faulted in again by every solve. --default-malloc: glibc's defaults.
@@ -136,10 +144,24 @@ int main(int argc, char** argv) {
     qs::PipelineOptions options;
     options.field.constraints.sharp_angle_deg = 35;  // the CLI's default
     options.param.second_thread = second_thread;
+    options.order_vertices = vertex_order;
     qs::Pipeline p(std::move(mesh), std::move(layout), options);
     const qs::CrossField& field = p.compute_field();
+    // The pipeline's parameterization options: with its vertex order, when it computed one
+    // beside the field (PipelineOptions::order_vertices).
+    options.param = p.options().param;
     std::printf("faces %d, nodes %zu, arcs %zu\n", p.geometry().n_faces, p.layout().nodes.size(),
                 p.layout().arcs.size());
+    if (options.param.vertex_order) {
+      const double c0 = cpu_seconds();
+      const std::vector<int> order = qs::vertex_nested_dissection(p.geometry());
+      std::printf(
+          "vertex order (nested dissection of the mesh's vertices, computed by the pipeline on "
+          "its second thread beside the field, not part of the stage): %.4f s CPU\n",
+          cpu_seconds() - c0);
+    } else {
+      std::printf("no vertex order: AMD on each reduced matrix\n");
+    }
     std::vector<double> stages, units, ratios, stages_wall, units_wall, ratios_wall;
     for (int r = 0; r < repeat; ++r) {
       const double c0 = cpu_seconds(), w0 = wall_seconds();

@@ -378,5 +378,53 @@ TEST(ReuseParam, PreparedSolversGiveTheSameParameterization) {
   EXPECT_FALSE(later.param_solver_prepared());
 }
 
+// PipelineOptions::order_vertices: the Pipeline orders the mesh's vertices once (nested
+// dissection, on its second thread), its parameterization's analysis takes that order, the
+// result is the AMD-ordered one up to round-off, and the pipelines continued from it share the
+// order, also when they are made before it was taken. Small meshes (below
+// second_thread_min_faces) and order_vertices = false keep AMD.
+TEST(ReuseParam, PipelineOrdersTheVerticesOnceForItsSolvers) {
+  const auto cs = test::cube_sphere(8, Vec3(2.0, 1.0, 0.6));
+  const Example ex{cs.mesh, cs.layout};
+  PipelineOptions options;
+  options.second_thread_min_faces = 0;  // a small mesh
+  ASSERT_TRUE(options.order_vertices);
+  ASSERT_TRUE(pipeline_orders_vertices(options, static_cast<int>(ex.mesh.n_faces())));
+  { Pipeline dropped(ex.mesh, ex.layout, options); }  // waits for its ordering thread
+  Pipeline ordered(ex.mesh, ex.layout, options);
+  const Parameterization& a = ordered.compute_parameterization();
+  const auto& order = ordered.options().param.vertex_order;
+  ASSERT_TRUE(order);
+  EXPECT_EQ(*order, vertex_nested_dissection(ordered.geometry()));
+  EXPECT_GE(ordered.param_solver()->linear_solver().stats().hinted_analyses, 1);
+
+  PipelineOptions off = options;
+  off.order_vertices = false;
+  EXPECT_FALSE(pipeline_orders_vertices(off, static_cast<int>(ex.mesh.n_faces())));
+  Pipeline plain(ex.mesh, ex.layout, off);
+  const Parameterization& b = plain.compute_parameterization();
+  EXPECT_FALSE(plain.options().param.vertex_order);
+  EXPECT_EQ(plain.param_solver()->linear_solver().stats().hinted_analyses, 0);
+  EXPECT_LT(corner_gap(a.corner_uv, b.corner_uv), 1e-9);
+  EXPECT_NEAR(a.energy, b.energy, 1e-9 * b.energy);
+
+  const Layout moved = moved_layout(ex.mesh, ex.layout, 1);
+  const TriMesh mesh = relocated(ex.mesh, ex.layout, 0.3, 1);
+  Pipeline continued(mesh, moved, ordered);
+  continued.compute_parameterization();
+  EXPECT_EQ(continued.options().param.vertex_order, order) << "not the same order object";
+  Pipeline early(ex.mesh, ex.layout, options);  // continued before it took its order
+  Pipeline continued_early(mesh, moved, early);
+  continued_early.compute_parameterization();
+  ASSERT_TRUE(continued_early.options().param.vertex_order);
+  EXPECT_EQ(*continued_early.options().param.vertex_order, *order);
+  EXPECT_GE(continued_early.param_solver()->linear_solver().stats().hinted_analyses, 1);
+
+  Pipeline small(ex.mesh, ex.layout);  // default threshold
+  ASSERT_LT(static_cast<int>(ex.mesh.n_faces()), PipelineOptions{}.second_thread_min_faces);
+  small.compute_parameterization();
+  EXPECT_FALSE(small.options().param.vertex_order);
+}
+
 }  // namespace
 }  // namespace qs

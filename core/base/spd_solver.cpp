@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/base/errors.h"
+#include "core/base/metis_signals.h"
 #include "core/base/solver_threads.h"
 #include "core/base/timing.h"
 
@@ -149,6 +150,7 @@ class SupernodalLlt
   void analyze_triangle(const Eigen::SparseMatrix<double>& A, bool upper) {
     if (m_cholmodFactor != nullptr) cholmod_free_factor(&m_cholmodFactor, &cholmod());
     cholmod_sparse a = pattern_view(A, upper);
+    const MetisSignalGuard guard;  // CHOLMOD's default may try METIS (metis_signals.h)
     m_cholmodFactor = cholmod_analyze(&a, &cholmod());
     m_isInitialized = true;
     m_info = m_cholmodFactor != nullptr ? Eigen::Success : Eigen::NumericalIssue;
@@ -511,6 +513,7 @@ std::vector<int> nested_dissection_ordering(int n, const std::vector<int>& start
   c.print = 0;
   // The lower entries of the both-ways adjacency are ignored.
   cholmod_sparse G = upper_pattern(n, start, adjacency);
+  const MetisSignalGuard guard;  // metis_signals.h
   const int ok = cholmod_metis(&G, nullptr, 0, /*postorder=*/0, perm.data(), &c);
   cholmod_finish(&c);
   if (!ok) return {};

@@ -168,7 +168,7 @@ std::vector<int> movable_nodes(const TriMesh& mesh, const Layout& layout) {
 // The optimization's state between units (NodeOptimizer::step), and the units themselves.
 struct NodeOptimizer::Impl {
   // The caller's; after the initial solve with NodeOptOptions::vertex_ordering, plus the vertex
-  // order that every later Pipeline uses.
+  // order that every later Pipeline uses (the initial Pipeline's, or computed here).
   PipelineOptions options;
   const NodeOptOptions no;
   const std::chrono::steady_clock::time_point t_start = std::chrono::steady_clock::now();
@@ -235,8 +235,12 @@ struct NodeOptimizer::Impl {
     check_cancel(observer);
     // The vertex order depends on the connectivity only: computed beside the initial solve (the
     // future waits in its destructor if that throws).
+    // On large meshes the initial Pipeline computes it (PipelineOptions::order_vertices).
     std::future<std::vector<int>> vertex_order;
-    if (no.vertex_ordering && !options.param.vertex_order)
+    if (!no.vertex_ordering)
+      options.order_vertices = false;
+    else if (!options.param.vertex_order &&
+             !pipeline_orders_vertices(options, original_geometry.n_faces))
       vertex_order = std::async(std::launch::async,
                                 [this] { return vertex_nested_dissection(original_geometry); });
     if (start && pipeline_matches(*start, mesh, layout)) {
@@ -256,6 +260,8 @@ struct NodeOptimizer::Impl {
         options.param.vertex_order = std::make_shared<const std::vector<int>>(std::move(order));
         current.pipeline->set_param_vertex_order(options.param.vertex_order);
       }
+    } else if (no.vertex_ordering && !options.param.vertex_order) {
+      options.param.vertex_order = current.pipeline->options().param.vertex_order;
     }
     fewest_folds_count = current.foldovers;
     result.E_init = current.E;

@@ -111,11 +111,14 @@ struct NodeOptOptions {
   //! `optimize --integer` turns it off (nodes on shared iso-lines, see cmd_optimize.cpp).
   bool reuse_field = true;
   //! The parameterizations of the trials take their fill-reducing ordering from one nested
-  //! dissection of the mesh's vertex graph (ParamOptions::vertex_order), computed beside the
-  //! initial solve, instead of an AMD ordering of every new reduced matrix. The initial solve
-  //! keeps AMD. Bunny (70K faces, 150 patches): the analysis of a re-layout takes about half the
-  //! time and each factorization about 20 % less (docs/benchmarks.md, session 22). Without
-  //! effect when the given PipelineOptions already carry a vertex order.
+  //! dissection of the mesh's vertex graph (ParamOptions::vertex_order) instead of an AMD
+  //! ordering of every new reduced matrix. On meshes where the initial Pipeline computes it
+  //! beside the field (PipelineOptions::order_vertices) the initial solve uses it too; on
+  //! smaller ones it is computed beside the initial solve, which keeps AMD. false also turns
+  //! PipelineOptions::order_vertices off. Bunny (70K faces, 150 patches): the analysis of a
+  //! re-layout takes about half the time and each factorization about 20 % less
+  //! (docs/benchmarks.md, session 22). Without effect when the given PipelineOptions already
+  //! carry a vertex order.
   bool vertex_ordering = true;
   //! Polish by discrete hops (discrete.h hop_sweep) when the descent ends (no node moves, more
   //! than max_halvings halvings, or the step budget is used up): the descent can stop in a local

@@ -482,15 +482,23 @@ std::vector<int> ParamSolver::vertex_order_hint(const Eigen::SparseMatrix<double
 }
 
 std::vector<int> vertex_nested_dissection(const GeometryCache& g) {
-  std::vector<int> start(g.n_vertices + 1, 0), adjacency(2 * static_cast<size_t>(g.n_edges));
-  for (const auto& [a, b] : g.edge_vertices) ++start[a + 1], ++start[b + 1];
-  for (int v = 0; v < g.n_vertices; ++v) start[v + 1] += start[v];
+  return vertex_nested_dissection(g.n_vertices, g.edge_vertices);
+}
+
+std::vector<int> vertex_nested_dissection(int n_vertices,
+                                          const std::vector<std::array<int, 2>>& edges) {
+  std::vector<int> start(n_vertices + 1, 0), adjacency(2 * edges.size());
+  for (const auto& [a, b] : edges) {
+    if (a < 0 || b < 0 || a >= n_vertices || b >= n_vertices) return {};
+    ++start[a + 1], ++start[b + 1];
+  }
+  for (int v = 0; v < n_vertices; ++v) start[v + 1] += start[v];
   std::vector<int> next(start.begin(), start.end() - 1);
-  for (const auto& [a, b] : g.edge_vertices) {
+  for (const auto& [a, b] : edges) {
     adjacency[next[a]++] = b;
     adjacency[next[b]++] = a;
   }
-  return nested_dissection_ordering(g.n_vertices, start, adjacency);
+  return nested_dissection_ordering(n_vertices, start, adjacency);
 }
 
 std::vector<double> ParamSolver::target_scales(const TriMesh& mesh, const GeometryCache& g,

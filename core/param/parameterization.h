@@ -53,10 +53,12 @@ struct ParamOptions {
   //! vertex eliminated k-th, size #V), or null. When set, a new reduced matrix's symbolic
   //! analysis takes its ordering from it (each unknown at its wedge's vertex, in that order; seam
   //! translations and the long columns of merged unknowns last) instead of AMD on the matrix.
-  //! The vertex order does not depend on the layout, so the node optimizer computes it once for
-  //! all its layouts (NodeOptOptions::vertex_ordering). Bunny, 70K faces, 150 patches: flops of
-  //! a factorization −38 %, its time −20 %, the analysis −50 %; on the joint (3751 nodes)
-  //! nnz(L) +8 % (docs/benchmarks.md, session 22). Takes precedence over wedge_ordering.
+  //! The vertex order does not depend on the layout: a Pipeline computes it once for all its
+  //! solvers and the pipelines continued from it (PipelineOptions::order_vertices), as does the
+  //! node optimizer on smaller meshes (NodeOptOptions::vertex_ordering). Bunny, 70K faces, 150
+  //! patches: flops of a factorization −38 %, its time −20 %, the analysis −50 %; on the joint
+  //! (3751 nodes) nnz(L) +8 % (docs/benchmarks.md, session 22). Takes precedence over
+  //! wedge_ordering.
   std::shared_ptr<const std::vector<int>> vertex_order;
   //! Runs independent parts of the stage on a second thread: the layout labels beside the cut
   //! graph (construction), and a symbolic analysis of the reduced matrix (a new pattern: a fresh
@@ -207,6 +209,11 @@ class ParamSolver {
 //! A nested-dissection order of \p geometry's vertices (their edge graph) for
 //! ParamOptions::vertex_order; empty when METIS fails (the solvers then use AMD).
 std::vector<int> vertex_nested_dissection(const GeometryCache& geometry);
+//! The same for the graph of \p n_vertices vertices and the undirected \p edges (each once;
+//! GeometryCache::edge_vertices), so that it can run apart from a GeometryCache that changes.
+//! Empty when an edge names a vertex outside 0..n_vertices−1.
+std::vector<int> vertex_nested_dissection(int n_vertices,
+                                          const std::vector<std::array<int, 2>>& edges);
 
 //! Energy (1) per face for given corner values (same conventions as the solver), without
 //! ParamOptions::face_weights. \p log_scale: the targets' per-face log-scale s_t

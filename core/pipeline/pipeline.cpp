@@ -23,6 +23,27 @@ Pipeline::Pipeline(TriMesh mesh, Layout layout, PipelineOptions options, bool va
   }
   topology_ = build_topology(mesh_, layout_);
   geometry_ = build_geometry(mesh_);
+  if (pipeline_orders_vertices(options_, geometry_.n_faces))
+    // The thread gets its own copy of the edges: update_positions rewrites geometry_.
+    vertex_order_ = std::async(std::launch::async, [n = geometry_.n_vertices,
+                                                    edges = geometry_.edge_vertices]() {
+                      std::vector<int> order = vertex_nested_dissection(n, edges);
+                      return order.empty()
+                                 ? std::shared_ptr<const std::vector<int>>()
+                                 : std::make_shared<const std::vector<int>>(std::move(order));
+                    }).share();
+}
+
+bool pipeline_orders_vertices(const PipelineOptions& options, int n_faces) {
+  return options.order_vertices && options.param.second_thread && !options.param.vertex_order &&
+         n_faces >= options.second_thread_min_faces;
+}
+
+void Pipeline::take_vertex_order() {
+  if (!vertex_order_.valid()) return;
+  std::shared_ptr<const std::vector<int>> order = vertex_order_.get();
+  vertex_order_ = {};
+  if (order && !options_.param.vertex_order) options_.param.vertex_order = std::move(order);
 }
 
 Pipeline::Pipeline(TriMesh mesh, Layout layout, const Pipeline& previous)
@@ -34,6 +55,7 @@ Pipeline::Pipeline(TriMesh mesh, Layout layout, const Pipeline& previous)
                             " faces, the previous pipeline's " +
                             std::to_string(previous.mesh_.n_vertices()) + " / " +
                             std::to_string(previous.mesh_.n_faces()));
+  vertex_order_ = previous.vertex_order_;  // when previous has not taken it yet
   topology_ = build_topology(mesh_, layout_);
   geometry_ = previous.geometry_;
   update_geometry(mesh_, geometry_);
@@ -73,6 +95,7 @@ const CrossField& Pipeline::compute_field() {
     CrossFieldSolver::ReferenceRotation rotation;
     if (options_.field.max_cluster_faces > 0)
       rotation = [this](const std::vector<int>& period_jump, const std::vector<double>& theta) {
+        take_vertex_order();
         try {
           auto solver =
               std::make_unique<ParamSolver>(mesh_, geometry_, layout_, topology_, period_jump,
@@ -103,6 +126,7 @@ const CrossField& Pipeline::compute_field() {
     std::promise<Jumps> jumps_promise;
     std::shared_future<Jumps> jumps;
     std::future<std::unique_ptr<ParamSolver>> prepared;
+    take_vertex_order();  // before the thread reads options_
     if (options_.param.second_thread && geometry_.n_faces >= options_.second_thread_min_faces) {
       jumps = jumps_promise.get_future().share();
       prepared = std::async(std::launch::async, [this, theta = field_solver_->field().theta,
@@ -164,6 +188,7 @@ const Parameterization& Pipeline::compute_parameterization() {
     // minimizes the energy, not an arbitrary anchor (that would depend on arc routing); the
     // solver's first solve waits until it is chosen.
     const bool free_rotation = field.gauge_face >= 0;
+    take_vertex_order();
     std::unique_ptr<ParamSolver> prepared = std::move(prepared_param_);
     if (prepared && prepared->adopt_field(mesh_, geometry_, layout_, topology_, field.period_jump,
                                           field.theta)) {

@@ -2,6 +2,7 @@
 // the editor's worker thread.
 #pragma once
 
+#include <future>
 #include <memory>
 #include <string>
 #include <vector>
@@ -28,7 +29,22 @@ struct PipelineOptions {
   //! more than it overlaps there (the 1728-face ellipsoid's node optimization took 13 % more CPU
   //! time with it).
   int second_thread_min_faces = 10000;
+  //! With ParamOptions::second_thread on meshes of at least second_thread_min_faces faces, and
+  //! unless ParamOptions::vertex_order is given: the Pipeline orders the mesh's vertices by
+  //! nested dissection (vertex_nested_dissection) on a second thread from its construction,
+  //! beside the field, and its parameterization solvers (and those of the pipelines continued
+  //! from it) take their fill-reducing ordering from that order (ParamOptions::vertex_order).
+  //! The order depends on the connectivity only. A solver built before it is ready waits for it,
+  //! so the results never depend on timing. Bunny, 70K faces: the order costs 0.12 s on the
+  //! second thread, and a parameterization stage takes about 0.14 s wall instead of 0.19–0.21 s
+  //! (a symbolic analysis without AMD, and 38 % fewer flops per factorization); QuadWild's
+  //! joint (43K faces): 0.084 s instead of 0.092 s (docs/benchmarks.md, session 23).
+  bool order_vertices = true;
 };
+
+//! Whether a Pipeline with \p options on a mesh of \p n_faces faces orders the vertices itself
+//! (PipelineOptions::order_vertices).
+bool pipeline_orders_vertices(const PipelineOptions& options, int n_faces);
 
 //! A singular vertex of the cross field.
 struct Singularity {
@@ -130,6 +146,13 @@ class Pipeline {
   bool param_prepared_ = false;  //!< param_solver_ was prepared_param_ (param_solver_prepared)
   std::unique_ptr<Extraction> extraction_;
   std::unique_ptr<Curvature> curvature_;
+  //! The vertex order being computed (PipelineOptions::order_vertices) until
+  //! take_vertex_order() moves it into options_.param.vertex_order; shared with the pipelines
+  //! continued from this one before that.
+  std::shared_future<std::shared_ptr<const std::vector<int>>> vertex_order_;
+  //! Waits for vertex_order_ (if any) and sets options_.param.vertex_order from it. Called on
+  //! the owner's thread before a parameterization solver is built.
+  void take_vertex_order();
 };
 
 //! Writes param.obj: the mesh (same vertex and face order) with one texture coordinate per
