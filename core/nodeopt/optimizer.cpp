@@ -233,9 +233,9 @@ struct NodeOptimizer::Impl {
     compute_movable();
     for (int n : movable) result.sliding_nodes += on_curve(state.layout.nodes[n].vertex);
     check_cancel(observer);
-    // The vertex order depends on the connectivity only: computed beside the initial solve (the
-    // future waits in its destructor if that throws).
-    // On large meshes the initial Pipeline computes it (PipelineOptions::order_vertices).
+    // The vertex order depends on the connectivity only. On large meshes the initial Pipeline
+    // computes it beside the field (PipelineOptions::order_vertices); otherwise it is computed
+    // here beside the initial solve (the future waits in its destructor if that throws).
     std::future<std::vector<int>> vertex_order;
     if (!no.vertex_ordering)
       options.order_vertices = false;
