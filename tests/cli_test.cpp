@@ -424,8 +424,9 @@ TEST(Cli, OrientationRemovesFoldoversWithoutNodeOptimization) {
 }
 
 // Where the orientation constraints are infeasible (mask_confmap.obj with a star of dangling
-// arcs to its free eye holes, as in orientation_test), the report lists the faces they violate
-// most and a warning names the layout node next to them.
+// arcs to its free eye holes and the field wrapping around them, --wrap-free-holes, as in
+// orientation_test), the report lists the faces they violate most and a warning names the
+// layout node next to them.
 TEST(Cli, InfeasibleOrientationNamesTheNodesWhereTheLayoutFolds) {
   const std::string dir = test::shared_meshes_dir();
   if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
@@ -438,7 +439,8 @@ TEST(Cli, InfeasibleOrientationNamesTheNodesWhereTheLayoutFolds) {
   const std::string layout_file = out_dir + "/star.layout.json";
   save_layout(layout, layout_file, &mesh);
   std::string out;
-  ASSERT_EQ(test::run_command(cli("optimize --no-node-opt --orientation --no-align --mesh " +
+  ASSERT_EQ(test::run_command(cli("optimize --no-node-opt --orientation --no-align "
+                                  "--wrap-free-holes --mesh " +
                                   mesh_file + " --layout " + layout_file + " --out " + out_dir),
                               &out),
             0)

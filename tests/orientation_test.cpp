@@ -520,10 +520,11 @@ void expect_named_faces_at_eye_holes(const TriMesh& mesh, const OrientationRepor
 }
 
 // mask_confmap.obj (three boundary loops) with one node and four dangling arcs to the eye
-// holes and the outer boundary (as in boundary_test): the fold-overs where the iso-lines wrap
-// around the free eye holes cannot be removed by the tri-sector constraints (the QP is
-// infeasible). The solve must say so and keep the unconstrained solution; the node optimizer
-// then falls back to stiffening.
+// holes and the outer boundary (as in boundary_test), with the field wrapping around the free
+// eye holes (FreeLoopTurning::kWrap, the default until session 23; the default now embeds this
+// layout): the fold-overs where the iso-lines wrap around the holes cannot be removed by the
+// tri-sector constraints (the QP is infeasible). The solve must say so and keep the
+// unconstrained solution; the node optimizer then falls back to stiffening.
 TEST(OrientationRealData, InfeasibleConstraintsOnMaskKeepTheSolveAndSayWhy) {
   const std::string dir = test::shared_meshes_dir();
   if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
@@ -534,6 +535,7 @@ TEST(OrientationRealData, InfeasibleConstraintsOnMaskKeepTheSolveAndSayWhy) {
   for (const LayoutArc& arc : layout.arcs) ASSERT_GE(arc.path.size(), 2u);
   PipelineOptions options;
   options.field.constraints.curvature = false;
+  options.field.free_loops = FreeLoopTurning::kWrap;
   Pipeline plain(mesh, layout, options);
   const Parameterization& a = plain.compute_parameterization();
   options.param.orientation.enabled = true;
@@ -553,10 +555,11 @@ TEST(OrientationRealData, InfeasibleConstraintsOnMaskKeepTheSolveAndSayWhy) {
   }
 }
 
-// OrientationOptions::stop_if_all_faces_infeasible on the mask (whose constraints are infeasible
-// on every face): small sets around the folded faces first (rings 0), then every face; that
-// round is infeasible, and the solve stops there with the best earlier round instead of growing
-// the set further (the node optimizer's setting where it has an earlier state to fall back to).
+// OrientationOptions::stop_if_all_faces_infeasible on the mask with wrapping eye holes (whose
+// constraints are infeasible on every face): small sets around the folded faces first (rings 0),
+// then every face; that round is infeasible, and the solve stops there with the best earlier round
+// instead of growing the set further (the node optimizer's setting where it has an earlier state to
+// fall back to).
 TEST(OrientationRealData, StopsWhenEveryFaceIsInfeasible) {
   const std::string dir = test::shared_meshes_dir();
   if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
@@ -565,6 +568,7 @@ TEST(OrientationRealData, StopsWhenEveryFaceIsInfeasible) {
   const Layout layout = test::dangling_star_layout(mesh, star.center, star.targets);
   PipelineOptions options;
   options.field.constraints.curvature = false;
+  options.field.free_loops = FreeLoopTurning::kWrap;
   options.param.orientation.enabled = true;
   options.param.orientation.rings = 0;
   options.param.orientation.all_faces_after_rounds = 1;
@@ -586,6 +590,77 @@ TEST(OrientationRealData, StopsWhenEveryFaceIsInfeasible) {
   // Every face constrained: the named faces could be anywhere on the mask.
   expect_named_faces_at_eye_holes(mesh, report[1]);
   EXPECT_LE(report[1].foldovers_after, report[1].foldovers_before);
+}
+
+// OrientationOptions::stop_if_all_faces_infeasible, on three triangles P, Q, R whose shared
+// unknown y1 must be positive for P and R and negative for Q: the unconstrained optimum folds P
+// and R; a round on them alone (rings 0) unfolds them and folds Q; the all-faces round that
+// follows (all_faces_after_rounds 1) is infeasible. With the option the solve stops there with
+// the best earlier round (Q folded); without it, it goes back to growing rounds, which are
+// infeasible too, one round later.
+TEST(OrientationQp, StopsWhenEveryFaceIsInfeasible) {
+  TriMesh mesh;
+  for (int t = 0; t < 3; ++t) {
+    const double x = 10.0 * t;
+    mesh.add_vertex(Vec3(x, 0, 0));
+    mesh.add_vertex(Vec3(x + 1, 0, 0));
+    mesh.add_vertex(Vec3(x + 0.5, 0.8, 0));
+    auto vh = [&](int k) { return mesh.vertex_handle(3 * t + k); };
+    mesh.add_face(vh(0), vh(1), vh(2));
+  }
+  const GeometryCache geometry = build_geometry(mesh);
+  const std::vector<double> theta{0.0, 0.0, 0.0};
+  const std::vector<int> corner_wedge{0, 1, 2, 3, 4, 5, 6, 7, 8};
+  // Wedge w holds (u, v) at x(2w), x(2w + 1). Triangle t: corners (10t, 0) and (10t + 1, 0)
+  // fixed; apex P = (y0, y1), Q = (10 + y0, −y1), R = (20.5, y1).
+  Reduction red;
+  red.z0 = Eigen::VectorXd::Zero(18);
+  red.Z.resize(18, 2);
+  for (int t = 0; t < 3; ++t) {
+    red.z0(6 * t) = 10.0 * t;
+    red.z0(6 * t + 2) = 10.0 * t + 1;
+  }
+  red.Z.insert(4, 0) = 1.0;  // P
+  red.Z.insert(5, 1) = 1.0;
+  red.z0(10) = 10.0;  // Q
+  red.Z.insert(10, 0) = 1.0;
+  red.Z.insert(11, 1) = -1.0;
+  red.z0(16) = 20.5;  // R
+  red.Z.insert(17, 1) = 1.0;
+  Eigen::SparseMatrix<double> A(2, 2);
+  A.insert(0, 0) = 1.0;
+  A.insert(1, 1) = 1.0;
+  const Eigen::VectorXd b = Eigen::Vector2d(0.5, -1.0);  // folds P and R
+  OrientationOptions o;
+  o.rings = 0;
+  o.all_faces_after_rounds = 1;
+  OrientationReport report[2];
+  Eigen::VectorXd y[2];
+  for (int stop = 0; stop < 2; ++stop) {
+    o.stop_if_all_faces_infeasible = stop != 0;
+    y[stop] = solve_oriented(mesh, geometry, theta, corner_wedge, red, A, b, b, o, &report[stop]);
+    std::printf(
+        "[stat] three triangles, stop %d: rounds %d, all faces %d, %d -> %d fold-overs, %s\n", stop,
+        report[stop].rounds, report[stop].all_faces ? 1 : 0, report[stop].foldovers_before,
+        report[stop].foldovers_after, report[stop].message.c_str());
+  }
+  for (int stop = 0; stop < 2; ++stop) {
+    EXPECT_EQ(report[stop].foldovers_before, 2);
+    EXPECT_EQ(report[stop].foldovers_after, 1) << "the best round: Q folded";
+    EXPECT_GT(y[stop](1), 0.0) << "the first round's solution: P and R unfolded";
+  }
+  EXPECT_TRUE(report[1].all_faces);
+  EXPECT_NE(report[1].message.find("infeasible on every face"), std::string::npos)
+      << report[1].message;
+  EXPECT_EQ(report[1].rounds, 2);
+  EXPECT_LT(report[1].rounds, report[0].rounds);
+  EXPECT_NE(report[0].message.find("kept the best earlier round"), std::string::npos)
+      << report[0].message;
+  for (int f : report[1].infeasible_faces) {
+    EXPECT_TRUE(f >= 0 && f < 3) << f;
+    EXPECT_NE(report[1].message.find(std::to_string(f)), std::string::npos);
+  }
+  EXPECT_FALSE(report[1].infeasible_faces.empty());
 }
 
 }  // namespace

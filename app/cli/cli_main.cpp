@@ -42,6 +42,15 @@ int main(int argc, char** argv) {
         ->capture_default_str();
   };
 
+  // field and optimize: CrossFieldOptions::free_loops.
+  auto add_free_holes_option = [](CLI::App* cmd, bool& value) {
+    cmd->add_flag("--wrap-free-holes", value,
+                  "Along boundary loops the layout leaves free (holes that only dangling arcs "
+                  "run into) the field follows the loop, so the iso-lines wrap around the hole "
+                  "(an O-grid, for many arcs radiating into it); by default it turns as around "
+                  "a regular point and the iso-lines run on across the hole");
+  };
+
   FieldOptions field;
   auto* cmd_field = app.add_subcommand("field", "Compute the guiding cross field of a layout");
   cmd_field->add_option("--mesh", field.mesh, "Triangle mesh")->required();
@@ -51,6 +60,7 @@ int main(int argc, char** argv) {
       ->add_option("--sharp-angle", field.sharp_angle_deg, "Sharp feature dihedral angle (deg)")
       ->capture_default_str();
   add_cluster_option(cmd_field, field.max_cluster_faces);
+  add_free_holes_option(cmd_field, field.wrap_free_holes);
 
   OptimizeOptions opt;
   auto* cmd_opt = app.add_subcommand("optimize", "Run the whole pipeline and write the results");
@@ -120,6 +130,7 @@ int main(int argc, char** argv) {
   cmd_opt->add_option("--sharp-angle", opt.sharp_angle_deg, "Sharp feature dihedral angle (deg)")
       ->capture_default_str();
   add_cluster_option(cmd_opt, opt.max_cluster_faces);
+  add_free_holes_option(cmd_opt, opt.wrap_free_holes);
   cmd_opt
       ->add_option("--threads", opt.threads,
                    "Threads of the math libraries (OpenBLAS, CHOLMOD's OpenMP regions); more "

@@ -85,6 +85,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     PipelineOptions options;
     options.field.constraints.sharp_angle_deg = o.sharp_angle_deg;
     options.field.max_cluster_faces = o.max_cluster_faces;
+    if (o.wrap_free_holes) options.field.free_loops = FreeLoopTurning::kWrap;
     options.field.constraints.curvature = !o.no_align;
     if (o.sizing) options.param.sizing.enabled = *o.sizing;
     if (o.integer && !(o.quad_size > 0 || o.quad_count > 0))

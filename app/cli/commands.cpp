@@ -77,6 +77,7 @@ int run_field(const FieldOptions& o, const CommonOptions& common) {
     PipelineOptions options;
     options.field.constraints.sharp_angle_deg = o.sharp_angle_deg;
     options.field.max_cluster_faces = o.max_cluster_faces;
+    if (o.wrap_free_holes) options.field.free_loops = FreeLoopTurning::kWrap;
     Pipeline pipeline(std::move(mesh), std::move(layout), options);
     report["layout"] = layout_json(pipeline.topology());
     t0 = std::chrono::steady_clock::now();

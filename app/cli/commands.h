@@ -21,6 +21,7 @@ struct FieldOptions {
   std::string mesh, layout, out;
   double sharp_angle_deg = 35.0;
   int max_cluster_faces = CrossFieldOptions{}.max_cluster_faces;
+  bool wrap_free_holes = false;  //!< CrossFieldOptions::free_loops = kWrap
 };
 
 struct OptimizeOptions {
@@ -43,7 +44,8 @@ struct OptimizeOptions {
   std::optional<bool> sizing;
   double sharp_angle_deg = 35.0;
   int max_cluster_faces = CrossFieldOptions{}.max_cluster_faces;
-  int threads = 1;  //!< math-library threads (core/base/solver_threads.h)
+  bool wrap_free_holes = false;  //!< CrossFieldOptions::free_loops = kWrap
+  int threads = 1;               //!< math-library threads (core/base/solver_threads.h)
   //! Wall-clock seconds for moving nodes (all node optimization runs together); 0: no limit.
   double time_limit_s = 0;
 };

@@ -68,9 +68,9 @@ void CrossFieldSolver::setup(const TriMesh& mesh, const GeometryCache& g, const 
   field_.dropped_constraints = 0;
   gauge_angle_ = 0;
   auto t0 = std::chrono::steady_clock::now();
-  field_.period_jump = period_jumps
-                           ? period_jumps(&field_.topology)
-                           : compute_period_jumps(mesh, g, layout, topology, &field_.topology);
+  field_.period_jump = period_jumps ? period_jumps(&field_.topology)
+                                    : compute_period_jumps(mesh, g, layout, topology,
+                                                           &field_.topology, options_.free_loops);
   field_.timings.period_jumps_s = seconds_since(t0);
 
   t0 = std::chrono::steady_clock::now();
@@ -958,9 +958,9 @@ const CrossField& CrossFieldSolver::update_layout(const TriMesh& mesh, const Geo
   field_.constraints.direction = constraints.direction;
   constraint_dir_ = std::move(constraints.direction);
   t0 = std::chrono::steady_clock::now();
-  field_.period_jump = period_jumps
-                           ? period_jumps(&field_.topology)
-                           : compute_period_jumps(mesh, g, layout, topology, &field_.topology);
+  field_.period_jump = period_jumps ? period_jumps(&field_.topology)
+                                    : compute_period_jumps(mesh, g, layout, topology,
+                                                           &field_.topology, options_.free_loops);
   field_.timings.period_jumps_s = seconds_since(t0);
   // Cluster membership depends on the constraint set only; the relative rotations on p.
   const std::vector<int> old_cluster = cluster_of_;

@@ -41,6 +41,8 @@ enum class ConflictDrop {
 
 struct CrossFieldOptions {
   double constraint_weight = 100.0;  //!< λ, the paper's penalty factor
+  //! How the field turns along boundary loops the layout leaves free (topology.h).
+  FreeLoopTurning free_loops = FreeLoopTurning::kCap;
   ConstraintOptions constraints;
   int max_rounding_passes = 5;  //!< re-rounding of cluster rotations after each solve
   ClusterWarmStart warm_start = ClusterWarmStart::Relaxed;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <deque>
 #include <map>
+#include <numeric>
 #include <sstream>
 
 #include "core/base/errors.h"
@@ -337,7 +338,7 @@ class ArcStrips {
 
 std::vector<int> compute_period_jumps(const TriMesh& mesh, const GeometryCache& g,
                                       const Layout& layout, const LayoutTopology& topo,
-                                      PeriodJumpReport* report) {
+                                      PeriodJumpReport* report, FreeLoopTurning free_loops) {
   const int nv = g.n_vertices, nf = g.n_faces, ne = g.n_edges;
   PeriodJumpReport rep;
   // c_v = 4 I_0(v) − 4 I_target(v).
@@ -486,10 +487,6 @@ std::vector<int> compute_period_jumps(const TriMesh& mesh, const GeometryCache& 
     row_cycle.push_back(static_cast<int>(c));
   }
   rep.cycles = static_cast<int>(rows.size());
-  // Boundary loops that no layout cycle determines (holes that dangling arcs run into, with
-  // no closed arc cycle around them): the field turns like the loop's tangent there, i.e. the
-  // loop itself is a cycle without corners. Added only where it raises the rank, so it never
-  // overrides what the layout implies.
   auto rank_of = [&](const std::vector<std::vector<long>>& R) {
     if (R.empty() || nfree == 0) return 0;
     Eigen::MatrixXd A(R.size(), nfree);
@@ -499,15 +496,43 @@ std::vector<int> compute_period_jumps(const TriMesh& mesh, const GeometryCache& 
     qr.setThreshold(1e-9);
     return static_cast<int>(qr.rank());
   };
+  // Boundary loops that no layout cycle determines (holes that dangling arcs run into, with
+  // no closed arc cycle around them, i.e. boundaries the layout leaves free), FreeLoopTurning:
+  // - kCap: the field turns along such a loop as around a regular point, as if the hole were
+  //   capped by a disk without singularity, so the iso-lines run on across the hole. A loop is
+  //   walked with the surface on its left, so the cap lies on its right: sectors term −4 (a
+  //   convex patch boundary walked with the patch on its left has +4).
+  // - kWrap: the field turns like the loop's tangent (sectors term 0, a cycle without corners,
+  //   as along an aligned boundary), so the iso-lines wrap around the hole.
+  // Gauss–Bonnet leaves one loop of a sphere with holes to the others: the shortest loops are
+  // taken first, so that the longest one (a disk's outer boundary) is the one determined. Each
+  // is added only where it raises the rank, so it never overrides what the layout implies.
+  // (Until session 23 every free loop wrapped, the shorter ones not first: the mask with arcs
+  // into both free eye holes then folded around the eyes, E 31454 with 45 fold-overs; capped,
+  // E 2752 and none.)
   if (nfree > 0 && rank_of(rows) < nfree) {
     std::vector<char> node_vertex(nv, 0);
     for (const auto& n : layout.nodes) node_vertex[n.vertex] = 1;
+    std::vector<double> loop_length(nb, 0.0);
+    for (int l = 0; l < nb; ++l)
+      for (size_t k = 0; k < loops[l].size(); ++k) {
+        const int a = loops[l][k], b = loops[l][(k + 1) % loops[l].size()];
+        loop_length[l] +=
+            (mesh.point(mesh.vertex_handle(a)) - mesh.point(mesh.vertex_handle(b))).norm();
+      }
+    std::vector<int> loop_order(nb);
+    std::iota(loop_order.begin(), loop_order.end(), 0);
+    std::stable_sort(loop_order.begin(), loop_order.end(),
+                     [&](int a, int b) { return loop_length[a] < loop_length[b]; });
+    const long sectors = free_loops == FreeLoopTurning::kCap ? -4 : 0;
     int current = rank_of(rows);
-    for (int l = 0; l < nb && current < nfree; ++l) {
+    for (int li = 0; li < nb && current < nfree; ++li) {
+      const int l = loop_order[li];
       bool has_node = false;
       for (int v : loops[l]) has_node |= node_vertex[v] != 0;
       if (has_node) continue;
-      CycleEquation eq = path_equation(mesh, g, loops[l], 0, "boundary loop " + std::to_string(l));
+      CycleEquation eq =
+          path_equation(mesh, g, loops[l], sectors, "boundary loop " + std::to_string(l));
       if (!eq.ok) continue;
       std::vector<long> row(nfree, 0);
       long b = eq.rhs;

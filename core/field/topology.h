@@ -19,7 +19,9 @@ struct PeriodJumpReport {
   int cycles = 0;          //!< layout cycles used
   int cycles_skipped = 0;  //!< cycles through the boundary that cannot carry a left strip
   int rank = 0;            //!< rank of the cycle system in the free unknowns
-  int boundary_loop_equations = 0;  //!< undetermined holes fixed to turn like their boundary
+  //! undetermined (free) boundary loops fixed to turn as around a regular point (a hole capped
+  //! by a disk without singularity), shortest loops first
+  int boundary_loop_equations = 0;
   int max_abs_jump = 0;
 };
 
@@ -27,6 +29,17 @@ struct PeriodJumpReport {
 //! elsewhere, and 0 (unused) on boundary vertices.
 std::vector<int> target_quarter_indices(const TriMesh& mesh, const Layout& layout,
                                         const LayoutTopology& topology);
+
+//! How the field turns along a boundary loop that the layout leaves free (no node on it, no
+//! closed arc cycle around it: a hole that only dangling arcs run into).
+enum class FreeLoopTurning {
+  //! As around a regular point, as if the hole were capped by a disk without singularity: the
+  //! iso-lines run on across the hole (one or a few arcs into a hole; the default).
+  kCap,
+  //! Like the loop's tangent, as along an aligned boundary: the iso-lines wrap around the hole,
+  //! an O-grid around it (many arcs radiating into a hub). The default until session 23.
+  kWrap,
+};
 
 //! Period jumps p_e per edge (size #E; 0 on boundary edges) for the canonical dual orientation
 //! of GeometryCache. Never reduced mod 4.
@@ -36,7 +49,8 @@ std::vector<int> target_quarter_indices(const TriMesh& mesh, const Layout& layou
 //!        generator when the layout does not determine it.
 std::vector<int> compute_period_jumps(const TriMesh& mesh, const GeometryCache& geometry,
                                       const Layout& layout, const LayoutTopology& topology,
-                                      PeriodJumpReport* report = nullptr);
+                                      PeriodJumpReport* report = nullptr,
+                                      FreeLoopTurning free_loops = FreeLoopTurning::kCap);
 
 //! Index of every interior vertex in quarter turns from the period jumps and κ alone:
 //! 4·I(v) = 4·I_0(v) − Σ_ccw p. Boundary vertices get 0. Size #V.

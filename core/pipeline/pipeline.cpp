@@ -135,7 +135,8 @@ const CrossField& Pipeline::compute_field() {
         std::vector<int> p;
         try {
           PeriodJumpReport report;
-          p = compute_period_jumps(mesh_, geometry_, layout_, topology_, &report);
+          p = compute_period_jumps(mesh_, geometry_, layout_, topology_, &report,
+                                   options_.field.free_loops);
           promise.set_value({p, report});
         } catch (...) {
           promise.set_exception(std::current_exception());  // update_layout throws it
