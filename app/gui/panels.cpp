@@ -396,6 +396,12 @@ void App::draw_pipeline_options() {
         "that crosses them mostly releases). 10 (the default) keeps far more in force and lowers "
         "the angle error on most layouts (--max-cluster-faces)");
   if (!o.align) ImGui::EndDisabled();
+  ImGui::Checkbox("Wrap free holes", &o.wrap_free_holes);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip(
+        "Holes that only dangling arcs run into: the iso-lines wrap around them (an O-grid, for "
+        "many arcs radiating into a hole) instead of running on across them as around a "
+        "regular point (--wrap-free-holes)");
   float anisotropy = float(o.anisotropy);
   if (ImGui::SliderFloat("Anisotropy", &anisotropy, 1.0f, 100.0f, "%.1f",
                          ImGuiSliderFlags_Logarithmic))
@@ -445,6 +451,7 @@ void App::draw_pipeline_options() {
     o.align = defaults.align;
     o.sharp_angle_deg = defaults.sharp_angle_deg;
     o.max_cluster_faces = defaults.max_cluster_faces;
+    o.wrap_free_holes = defaults.wrap_free_holes;
     o.anisotropy = defaults.anisotropy;
     o.node_optimization = defaults.node_optimization;
     o.max_steps = defaults.max_steps;

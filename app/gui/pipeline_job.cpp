@@ -72,6 +72,7 @@ PipelineOptions pipeline_options(const WorkerOptions& o) {
   options.field.constraints.curvature = o.align;
   options.field.constraints.sharp_angle_deg = o.sharp_angle_deg;
   options.field.max_cluster_faces = o.max_cluster_faces;
+  if (o.wrap_free_holes) options.field.free_loops = FreeLoopTurning::kWrap;
   options.param.anisotropy = o.anisotropy;
   return options;
 }

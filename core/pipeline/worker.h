@@ -43,6 +43,8 @@ struct WorkerOptions {
   double sharp_angle_deg = 35.0;  //!< sharp feature dihedral angle (--sharp-angle)
   //! Split curvature clusters of at most this many faces (--max-cluster-faces; 0: off)
   int max_cluster_faces = CrossFieldOptions{}.max_cluster_faces;
+  //! Iso-lines wrap around holes that only dangling arcs run into (--wrap-free-holes)
+  bool wrap_free_holes = false;
   double anisotropy = 10.0;       //!< anisotropic norm factor of the parameterization energy
   double alpha = 0.75;            //!< initial damping α of node-optimization steps
   int descent_steps = 25;         //!< descent steps before the first hop sweep (--steps)
