@@ -40,7 +40,7 @@ Vec3 centroid(const TriMesh& mesh, const std::vector<int>& vertices) {
 // layout's. Fold-overs next to a free boundary are left to node optimization (issue #4 note),
 // so the full embedding check runs on the alignment-oblivious field.
 void expect_embedding(const TriMesh& mesh, const Layout& layout, int expected_patches, bool aligned,
-                      double max_foldover_fraction = 0.0) {
+                      double max_foldover_fraction = 0.0, double* energy = nullptr) {
   const auto v = validate_layout(mesh, layout);
   for (const auto& i : v.issues) ADD_FAILURE() << format_issue(i);
   ASSERT_TRUE(v.valid());
@@ -54,6 +54,7 @@ void expect_embedding(const TriMesh& mesh, const Layout& layout, int expected_pa
       "[stat] %s field, %zu faces: E = %.6g, fold-overs %d, dropped constraint clusters %d of %d\n",
       aligned ? "aligned" : "unaligned", mesh.n_faces(), param.energy, param.foldovers,
       field.dropped_clusters, field.clusters);
+  if (energy) *energy = param.energy;
   if (aligned) return;
   const Extraction& ex = pipeline.extract();
   for (const auto& p : ex.problems) ADD_FAILURE() << p;
@@ -133,23 +134,11 @@ TEST(Boundary, FreeHoleInAFlatSquareIsIsometric) {
   layout.arcs.push_back(test::make_arc(1, 0, -1, line(3, 6, 3, 12)));  // up to the outer boundary
   layout.arcs.push_back(test::make_arc(2, 0, -1, line(3, 6, 0, 6)));   // left
   layout.arcs.push_back(test::make_arc(3, 0, -1, line(3, 6, 3, 0)));   // down
-  const auto v = validate_layout(mesh, layout);
-  for (const auto& issue : v.issues) ADD_FAILURE() << format_issue(issue);
-  ASSERT_TRUE(v.valid());
-  PipelineOptions options;
-  options.field.constraints.curvature = false;
-  Pipeline pipeline(mesh, layout, options);
-  const CrossField& field = pipeline.compute_field();
-  EXPECT_TRUE(pipeline.singularities().empty());
-  EXPECT_EQ(field.topology.boundary_loop_equations, 1);
-  const Parameterization& param = pipeline.compute_parameterization();
-  std::printf("[stat] flat square with a free hole: E %.3g, fold-overs %d\n", param.energy,
-              param.foldovers);
-  EXPECT_LT(param.energy, 1e-9);
-  EXPECT_EQ(param.foldovers, 0);
-  const Extraction& ex = pipeline.extract();
-  for (const auto& p : ex.problems) ADD_FAILURE() << p;
-  EXPECT_TRUE(ex.structurally_equivalent);
+  double energy = -1;
+  expect_embedding(mesh, layout, 3, /*aligned=*/false, 0.0, &energy);
+  std::printf("[stat] flat square with a free hole: E %.3g\n", energy);
+  EXPECT_GE(energy, 0.0);
+  EXPECT_LT(energy, 1e-9) << "not isometric";
 }
 
 // A 2×2 grid aligned with the boundary loop \p loop of a disk: 8 nodes on the boundary loop
