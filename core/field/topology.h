@@ -19,8 +19,7 @@ struct PeriodJumpReport {
   int cycles = 0;          //!< layout cycles used
   int cycles_skipped = 0;  //!< cycles through the boundary that cannot carry a left strip
   int rank = 0;            //!< rank of the cycle system in the free unknowns
-  //! undetermined (free) boundary loops fixed to turn as around a regular point (a hole capped
-  //! by a disk without singularity), shortest loops first
+  //! undetermined (free) boundary loops whose turning FreeLoopTurning fixed, shortest first
   int boundary_loop_equations = 0;
   int max_abs_jump = 0;
 };
@@ -37,7 +36,8 @@ enum class FreeLoopTurning {
   //! iso-lines run on across the hole (one or a few arcs into a hole; the default).
   kCap,
   //! Like the loop's tangent, as along an aligned boundary: the iso-lines wrap around the hole,
-  //! an O-grid around it (many arcs radiating into a hub). The default until session 23.
+  //! an O-grid around it (many arcs radiating into a hub). Every free loop did this until
+  //! session 23 (then in the order the loops were listed, not shortest first).
   kWrap,
 };
 
