@@ -91,9 +91,8 @@ void compact(Terms& t) {
   t.swap(out);
 }
 
-// Local 2D gradient operator of face f: ∇φ_k (2D, in the frame r_f, n×r_f), and the area
-// (GeometryCache::face_gradient).
-//! \throw InvalidInputError when \p g does not hold them (a cache not from build_geometry).
+// Checks that \p g holds the per-face gradients face_gradients reads.
+// \throw InvalidInputError when it does not (a cache not from build_geometry).
 void check_face_gradients(const GeometryCache& g) {
   if (static_cast<int>(g.face_gradient.size()) != g.n_faces)
     throw InvalidInputError("geometry cache has " + std::to_string(g.face_gradient.size()) +
@@ -101,6 +100,8 @@ void check_face_gradients(const GeometryCache& g) {
                             " faces (build it with build_geometry)");
 }
 
+// Local 2D gradient operator of face f: ∇φ_k (2D, in the frame r_f, n×r_f), and the area
+// (GeometryCache::face_gradient; check_face_gradients first).
 void face_gradients(const GeometryCache& g, int f, Eigen::Matrix<double, 2, 3>& G, double& area) {
   const std::array<double, 7>& grad = g.face_gradient[f];
   for (int k = 0; k < 3; ++k) G.col(k) = Eigen::Vector2d(grad[2 * k], grad[2 * k + 1]);
