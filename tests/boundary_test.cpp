@@ -108,32 +108,10 @@ TEST(Boundary, MaskWithArcsIntoBothEyes) {
 // like its tangent instead (as an aligned boundary), the field would have to wrap around the
 // hole and the map would distort and fold.
 TEST(Boundary, FreeHoleInAFlatSquareIsIsometric) {
-  const int n = 12;
-  TriMesh mesh;
-  auto id = [&](int i, int j) { return j * (n + 1) + i; };
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) mesh.add_vertex(Vec3(i, j, 0));
-  auto vh = [&](int i, int j) { return mesh.vertex_handle(id(i, j)); };
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      if (i >= 6 && i < 9 && j >= 5 && j < 8) continue;  // the hole: 3 × 3 quads
-      mesh.add_face(vh(i, j), vh(i + 1, j), vh(i + 1, j + 1));
-      mesh.add_face(vh(i, j), vh(i + 1, j + 1), vh(i, j + 1));
-    }
-  ASSERT_EQ(boundary_loops(mesh).size(), 2u);
-  auto line = [&](int i0, int j0, int i1, int j1) {
-    std::vector<int> path;
-    const int steps = std::max(std::abs(i1 - i0), std::abs(j1 - j0));
-    for (int t = 0; t <= steps; ++t)
-      path.push_back(id(i0 + (i1 - i0) * t / steps, j0 + (j1 - j0) * t / steps));
-    return path;
-  };
-  Layout layout;
-  layout.nodes.push_back(test::make_node(0, id(3, 6)));
-  layout.arcs.push_back(test::make_arc(0, 0, -1, line(3, 6, 6, 6)));   // into the hole
-  layout.arcs.push_back(test::make_arc(1, 0, -1, line(3, 6, 3, 12)));  // up to the outer boundary
-  layout.arcs.push_back(test::make_arc(2, 0, -1, line(3, 6, 0, 6)));   // left
-  layout.arcs.push_back(test::make_arc(3, 0, -1, line(3, 6, 3, 0)));   // down
+  const test::MeshAndLayout sq = test::flat_square_with_free_hole();
+  ASSERT_EQ(boundary_loops(sq.mesh).size(), 2u);
+  const TriMesh& mesh = sq.mesh;
+  const Layout& layout = sq.layout;
   double energy = -1;
   expect_embedding(mesh, layout, 3, /*aligned=*/false, 0.0, &energy);
   std::printf("[stat] flat square with a free hole: E %.3g\n", energy);

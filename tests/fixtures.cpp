@@ -320,6 +320,33 @@ MeshAndLayout disk_grid(int nx, int ny, int px, int py) {
   return out;
 }
 
+MeshAndLayout flat_square_with_free_hole() {
+  const int n = 12;
+  MeshAndLayout out;
+  TriMesh& mesh = out.mesh;
+  auto id = [&](int i, int j) { return j * (n + 1) + i; };
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) mesh.add_vertex(Vec3(i, j, 0));
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      if (i >= 6 && i < 9 && j >= 5 && j < 8) continue;  // the hole: 3 × 3 quads
+      add_quad(mesh, id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1), false);
+    }
+  auto line = [&](int i0, int j0, int i1, int j1) {
+    std::vector<int> path;
+    const int steps = std::max(std::abs(i1 - i0), std::abs(j1 - j0));
+    for (int t = 0; t <= steps; ++t)
+      path.push_back(id(i0 + (i1 - i0) * t / steps, j0 + (j1 - j0) * t / steps));
+    return path;
+  };
+  out.layout.nodes.push_back(make_node(0, id(3, 6)));
+  out.layout.arcs.push_back(make_arc(0, 0, -1, line(3, 6, 6, 6)));   // into the hole
+  out.layout.arcs.push_back(make_arc(1, 0, -1, line(3, 6, 3, 12)));  // up to the outer boundary
+  out.layout.arcs.push_back(make_arc(2, 0, -1, line(3, 6, 0, 6)));   // left
+  out.layout.arcs.push_back(make_arc(3, 0, -1, line(3, 6, 3, 0)));   // down
+  return out;
+}
+
 MeshAndLayout voxel_surface(const std::vector<std::array<int, 3>>& voxels, int k) {
   MeshAndLayout out;
   TriMesh& mesh = out.mesh;

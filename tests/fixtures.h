@@ -73,6 +73,13 @@ MeshAndLayout torus_grid(int nu, int nv, int pu, int pv, double R = 2.0, double 
 //! corners, arcs along grid lines including the boundary.
 MeshAndLayout disk_grid(int nx, int ny, int px, int py);
 
+//! Flat square [0,12]² (unit grid, triangulated) with a 3 × 3 hole at [6,9]×[5,8], and a star of
+//! four dangling arcs along grid lines from the node at (3, 6): into the hole, up, left and down
+//! to the outer boundary. The hole is a free boundary loop; the layout's exact
+//! parameterization is the identity (E = 0) when the field turns around the hole as around a
+//! regular point (FreeLoopTurning::kCap).
+MeshAndLayout flat_square_with_free_hole();
+
 //! Boundary surface of a union of unit voxels (x, y, z integer cells), each voxel face split
 //! k×k and triangulated. Layout: nodes at every lattice point of the voxel grid on the
 //! surface, arcs along every voxel edge on the surface (one patch per voxel face). Sharp 90°

@@ -12,6 +12,7 @@
 #include "core/layout/layout_io.h"
 #include "core/nodeopt/optimizer.h"
 #include "core/pipeline/pipeline.h"
+#include "tests/fixtures.h"
 #include "tests/gui_job_fixture.h"
 
 namespace qs::app {
@@ -153,6 +154,28 @@ TEST(GuiJob, FixedNodesRemoveFoldoversWhenAsked) {
   const auto first = test::run_job(ex, with_nodeopt);
   ASSERT_EQ(first->status, WorkerStatus::Finished) << first->message;
   EXPECT_EQ(first->metrics.foldovers, plain->metrics.foldovers) << first->message;
+}
+
+// "Wrap free holes" (WorkerOptions::wrap_free_holes) reaches the field: on a flat square with a
+// free hole the default (capped hole) gives the exact, isometric solve; wrapping the iso-lines
+// around the hole distorts and folds (as --wrap-free-holes).
+TEST(GuiJob, WrapFreeHolesReachesTheField) {
+  const test::MeshAndLayout sq = test::flat_square_with_free_hole();
+  const Example ex{std::make_shared<const TriMesh>(sq.mesh), sq.layout};
+  WorkerOptions options = steps(1);
+  options.node_optimization = false;
+  options.align = false;
+  const auto capped = test::run_job(ex, options);
+  ASSERT_EQ(capped->status, WorkerStatus::Finished) << capped->message;
+  options.wrap_free_holes = true;
+  const auto wrapped = test::run_job(ex, options);
+  ASSERT_EQ(wrapped->status, WorkerStatus::Finished) << wrapped->message;
+  std::printf("[stat] flat square with a free hole in the editor: E %.3g capped, %.3g wrapped\n",
+              capped->metrics.E, wrapped->metrics.E);
+  EXPECT_LT(capped->metrics.E, 1e-9);
+  EXPECT_EQ(capped->metrics.foldovers, 0);
+  EXPECT_GT(wrapped->metrics.E, 1.0);
+  EXPECT_GT(wrapped->metrics.foldovers, 0);
 }
 
 // A run with the default settings ends where `quadsketch-cli optimize` ends (without
