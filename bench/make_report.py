@@ -197,6 +197,33 @@ def svg_plot(title, series, path):
         f.write("\n".join(out) + "\n")
 
 
+# Separates the generated part of docs/benchmarks.md from the notes kept across runs.
+NOTES_MARKER = ("<!-- Generated above (scripts/bench.sh); the notes below are written by hand "
+                "and kept when the page is regenerated. -->")
+# Before the marker existed, the hand-written notes began with this section.
+FIRST_NOTES_HEADING = "## Cross-field stage cost (session 2)"
+
+
+def previous_notes(path):
+    """The hand-written part of an existing page: what follows the marker (or, in a page from
+    before the marker, the first notes heading on). Empty when there is no page. Raises when a
+    page exists but neither is found, rather than dropping text nobody can regenerate."""
+    try:
+        with open(path) as f:
+            text = f.read()
+    except FileNotFoundError:
+        return ""
+    if NOTES_MARKER in text:
+        return text.split(NOTES_MARKER, 1)[1].strip("\n")
+    at = text.find("\n" + FIRST_NOTES_HEADING + "\n")
+    if at >= 0:
+        return text[at + 1:].strip("\n")
+    if not text.strip():
+        return ""
+    raise SystemExit(f"make_report: {path} has no notes marker ({NOTES_MARKER!r}); "
+                     "refusing to overwrite it (move it away to start a new page)")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--runs", required=True)
@@ -406,8 +433,17 @@ def main():
                   f"`{r['command'].replace(os.getcwd() + '/', '')}` |")
     md.append("")
 
-    with open(args.markdown, "w") as f:
-        f.write("\n".join(md))
+    # The measurement notes below the marker (one section per session, written by hand) are
+    # kept: only the part above it is this run's. Written to a temporary file and renamed, so
+    # that an interrupted run leaves the page as it was.
+    kept = previous_notes(args.markdown)
+    md += [NOTES_MARKER, ""]
+    if kept:
+        md.append(kept)
+    tmp = args.markdown + ".tmp"
+    with open(tmp, "w") as f:
+        f.write("\n".join(md).rstrip("\n") + "\n")
+    os.replace(tmp, args.markdown)
     results = {"machine": machine, "speed": speed,
                "runs": {n: {k: v for k, v in r.items() if k != "log_steps"}
                         for n, r in runs.items()},

@@ -178,6 +178,27 @@ TEST(GuiJob, WrapFreeHolesReachesTheField) {
   EXPECT_GT(wrapped->metrics.foldovers, 0);
 }
 
+// "Sizing field" (WorkerOptions::sizing) reaches the parameterization: on the bundled sketch
+// with fixed nodes the sized targets give a lower residual and no fold-over (as `optimize
+// --no-node-opt --sizing`), while the default unit targets fold.
+TEST(GuiJob, SizingFieldReachesTheParameterization) {
+  const Example ex = example();
+  WorkerOptions options = steps(1);
+  options.node_optimization = false;
+  ASSERT_FALSE(options.sizing) << "the editor follows the library default (off)";
+  const auto unit = test::run_job(ex, options);
+  ASSERT_EQ(unit->status, WorkerStatus::Finished) << unit->message;
+  options.sizing = true;
+  const auto sized = test::run_job(ex, options);
+  ASSERT_EQ(sized->status, WorkerStatus::Finished) << sized->message;
+  std::printf(
+      "[stat] bundled sketch in the editor: E %.4g unit targets (%d fold-overs), %.4g sized (%d)\n",
+      unit->metrics.E, unit->metrics.foldovers, sized->metrics.E, sized->metrics.foldovers);
+  EXPECT_LT(sized->metrics.E, unit->metrics.E);
+  EXPECT_GT(unit->metrics.foldovers, 0);
+  EXPECT_EQ(sized->metrics.foldovers, 0);
+}
+
 // A run with the default settings ends where `quadsketch-cli optimize` ends (without
 // stiffening, which the editor leaves out): the same units (descent steps, hop sweeps,
 // fold-over removal), so the same final mesh and node vertices, below the descent alone.

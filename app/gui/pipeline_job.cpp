@@ -74,6 +74,7 @@ PipelineOptions pipeline_options(const WorkerOptions& o) {
   options.field.max_cluster_faces = o.max_cluster_faces;
   if (o.wrap_free_holes) options.field.free_loops = FreeLoopTurning::kWrap;
   options.param.anisotropy = o.anisotropy;
+  options.param.sizing.enabled = o.sizing;
   return options;
 }
 

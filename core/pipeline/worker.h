@@ -25,6 +25,7 @@
 #include "core/field/cross_field.h"
 #include "core/layout/layout.h"
 #include "core/mesh/mesh.h"
+#include "core/param/sizing.h"
 #include "core/pipeline/snapshot.h"
 
 namespace qs {
@@ -45,7 +46,9 @@ struct WorkerOptions {
   int max_cluster_faces = CrossFieldOptions{}.max_cluster_faces;
   //! Iso-lines wrap around holes that only dangling arcs run into (--wrap-free-holes)
   bool wrap_free_holes = false;
-  double anisotropy = 10.0;       //!< anisotropic norm factor of the parameterization energy
+  double anisotropy = 10.0;  //!< anisotropic norm factor of the parameterization energy
+  //! Curl-reducing sizing field (--sizing; SizingOptions::enabled: off by default)
+  bool sizing = SizingOptions{}.enabled;
   double alpha = 0.75;            //!< initial damping α of node-optimization steps
   int descent_steps = 25;         //!< descent steps before the first hop sweep (--steps)
   bool keep_sharp_edges = false;  //!< sharp edges as feature curves (--keep-sharp-edges)
