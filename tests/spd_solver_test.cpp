@@ -199,6 +199,52 @@ TEST(SpdSolver, GroupedAmdOrderingIsUsedAndGivesTheSameSolution) {
   EXPECT_TRUE(grouped_amd_ordering(A, bad).empty());
 }
 
+// An "arrow" matrix: unknown 0 couples every other one, the others only themselves (both
+// triangles stored). Eliminated first, the hub fills L completely; eliminated last, L has the
+// pattern of A's lower triangle.
+Eigen::SparseMatrix<double> arrow(int n) {
+  std::vector<Eigen::Triplet<double>> t;
+  for (int k = 0; k < n; ++k) t.emplace_back(k, k, k == 0 ? double(n) : 2.0);
+  for (int k = 1; k < n; ++k) t.emplace_back(k, 0, 0.5), t.emplace_back(0, k, 0.5);
+  Eigen::SparseMatrix<double> A(n, n);
+  A.setFromTriplets(t.begin(), t.end());
+  A.makeCompressed();
+  return A;
+}
+
+// A given ordering whose fill is far beyond SpdSolver::kSuspiciousFillPerNonzero per nonzero of
+// A (the hub first: n(n+1)/2 nonzeros of L for 3n−2 of A) is replaced by CHOLMOD's own, which
+// finds the arrow's 2n−1; a good one (the hub last) is kept. Same solution either way.
+TEST(SpdSolver, AnOrderingHintWithFarMoreFillIsReplaced) {
+  const int n = 400;
+  const auto A = arrow(n);
+  const Eigen::VectorXd b = random_vector(n, 11);
+  std::vector<int> hub_first(n), hub_last(n);
+  for (int k = 0; k < n; ++k) hub_first[k] = k, hub_last[k] = (k + 1) % n;
+
+  SpdSolver bad("bad hint");
+  bad.set_ordering_hint(hub_first);
+  bad.factorize(A);
+  EXPECT_EQ(bad.stats().rejected_hints, 1);
+  EXPECT_EQ(bad.stats().hinted_analyses, 0);
+  EXPECT_LE(bad.stats().factor_nonzeros, 2.0 * n);
+  EXPECT_NE(bad.ordering().front(), 0) << "the hub is not eliminated first";
+
+  SpdSolver good("good hint");
+  good.set_ordering_hint(hub_last);
+  good.factorize(A);
+  EXPECT_EQ(good.stats().rejected_hints, 0);
+  EXPECT_EQ(good.stats().hinted_analyses, 1);
+  EXPECT_EQ(good.ordering().back(), 0) << "the hub is eliminated last";
+  EXPECT_LE(good.stats().factor_nonzeros, 2.0 * n);
+
+  // Without the check the bad hint's fill would be complete.
+  EXPECT_GT(0.5 * n * (n + 1), SpdSolver::kSuspiciousFillPerNonzero * A.nonZeros());
+  const Eigen::VectorXd xb = bad.solve(b), xg = good.solve(b);
+  EXPECT_LT(relative_residual(A, xb, b), 1e-10);
+  EXPECT_LT((xb - xg).norm(), 1e-9 * xg.norm());
+}
+
 // nested_dissection_ordering: a permutation whose last nodes (the top-level separator) cut a
 // grid graph in two; as a hint it gives the default ordering's solution. Input that does not
 // describe a graph gives no ordering.

@@ -78,6 +78,7 @@ class SupernodalLlt
     if (copy == nullptr) copy = cholmod_copy_factor(from.m_cholmodFactor, &cholmod());
     if (copy == nullptr) return false;
     adopt(copy);
+    factor_nonzeros_ = from.factor_nonzeros_;
     return true;
   }
   //! Copy of \p from's whole factor (symbolic and numeric) and its factorized state.
@@ -86,6 +87,7 @@ class SupernodalLlt
     cholmod_factor* copy = cholmod_copy_factor(from.m_cholmodFactor, &cholmod());
     if (copy == nullptr) return false;
     adopt(copy);
+    factor_nonzeros_ = from.factor_nonzeros_;
     m_factorizationIsOk = from.m_factorizationIsOk;
     m_info = from.m_info;
     return true;
@@ -152,6 +154,7 @@ class SupernodalLlt
     cholmod_sparse a = pattern_view(A, upper);
     const MetisSignalGuard guard;  // CHOLMOD's default may try METIS (metis_signals.h)
     m_cholmodFactor = cholmod_analyze(&a, &cholmod());
+    factor_nonzeros_ = m_cholmodFactor != nullptr ? cholmod().lnz : 0;
     m_isInitialized = true;
     m_info = m_cholmodFactor != nullptr ? Eigen::Success : Eigen::NumericalIssue;
     m_analysisIsOk = m_cholmodFactor != nullptr;
@@ -210,6 +213,7 @@ class SupernodalLlt
     c.nmethods = 1;
     c.method[0].ordering = CHOLMOD_GIVEN;
     m_cholmodFactor = cholmod_analyze_p(&a, perm.data(), nullptr, 0, &c);
+    factor_nonzeros_ = m_cholmodFactor != nullptr ? c.lnz : 0;
     c.nmethods = nmethods;
     c.method[0].ordering = ordering;
     m_isInitialized = true;
@@ -217,6 +221,8 @@ class SupernodalLlt
     m_analysisIsOk = m_cholmodFactor != nullptr;
     m_factorizationIsOk = false;
   }
+  //! Nonzeros of L the current analysis predicts (CHOLMOD's lnz; 0 without one).
+  double factor_nonzeros() const { return m_analysisIsOk ? factor_nonzeros_ : 0; }
   //! The ordering of the current analysis (empty without one).
   std::vector<int> ordering() const {
     if (!m_analysisIsOk || m_cholmodFactor == nullptr || m_cholmodFactor->Perm == nullptr)
@@ -224,6 +230,9 @@ class SupernodalLlt
     const int* p = static_cast<const int*>(m_cholmodFactor->Perm);
     return std::vector<int>(p, p + m_cholmodFactor->n);
   }
+
+ private:
+  double factor_nonzeros_ = 0;
 };
 
 }  // namespace
@@ -272,6 +281,20 @@ SpdSolver::AnalysisResult SpdSolver::run_analysis(Impl& impl, const Eigen::Spars
   if (static_cast<Eigen::Index>(hint.size()) == A.rows() && A.rows() > 0) {
     impl.llt.analyze_with_ordering(A, upper, hint);
     result.hinted = true;
+    // A given ordering is cheaper than AMD's but can be far worse on a pattern it was not made
+    // for. Where its fill is suspiciously large, CHOLMOD's own ordering is computed too and the
+    // one with less fill kept (the given one analyzed again when it wins).
+    const double hinted_fill = impl.llt.factor_nonzeros();
+    if (impl.llt.info() == Eigen::Success &&
+        hinted_fill > kSuspiciousFillPerNonzero * static_cast<double>(A.nonZeros())) {
+      impl.llt.analyze_triangle(A, upper);
+      if (impl.llt.info() == Eigen::Success && impl.llt.factor_nonzeros() < hinted_fill) {
+        result.hinted = false;
+        result.rejected_hint = true;
+      } else {
+        impl.llt.analyze_with_ordering(A, upper, hint);
+      }
+    }
   } else {
     impl.llt.analyze_triangle(A, upper);
   }
@@ -289,6 +312,7 @@ SpdSolver::AnalysisResult SpdSolver::run_analysis(Impl& impl, const Eigen::Spars
   }
   impl.analyzed = true;
   impl.upper = upper;
+  result.factor_nonzeros = impl.llt.factor_nonzeros();
   result.seconds = seconds_since(t0);
   return result;
 }
@@ -366,6 +390,8 @@ void SpdSolver::note_analysis(const AnalysisResult& result) {
   stats_.analyze_s = result.seconds;
   ++stats_.analyses;
   stats_.hinted_analyses += result.hinted;
+  stats_.rejected_hints += result.rejected_hint;
+  stats_.factor_nonzeros = result.factor_nonzeros;
 }
 
 void SpdSolver::factorize(const Eigen::SparseMatrix<double>& A) {

@@ -14,6 +14,10 @@ struct SpdSolverStats {
   double analyze_s = 0, factorize_s = 0, solve_s = 0;
   int analyses = 0, factorizations = 0, solves = 0;
   int hinted_analyses = 0;  //!< analyses that used a given ordering (set_ordering_hint)
+  //! Analyses whose given ordering was dropped for CHOLMOD's own (more than
+  //! SpdSolver::kSuspiciousFillPerNonzero nonzeros of L per nonzero of A, and more than AMD's)
+  int rejected_hints = 0;
+  double factor_nonzeros = 0;  //!< nonzeros of L predicted by the last analysis
   //! factorizations that scattered A's values into the lower triangle of P·A·Pᵀ, laid out once
   //! per analysis (every one of a compressed matrix), instead of CHOLMOD's permuted transposes
   int scattered_factorizations = 0;
@@ -86,6 +90,11 @@ class SpdSolver {
   //! when its size matches the matrix; a good ordering of a similar pattern (e.g. mapped from
   //! the previous step's system) gives nearly the same fill at a fraction of the analysis cost.
   //! Used once; an empty vector or one that is not a permutation clears the hint.
+  //! When the given ordering's L has more than this many nonzeros per nonzero of A, CHOLMOD's
+  //! own ordering is computed too and the one with less fill kept. Good orderings of the
+  //! parameterization systems give 1.3–4.6 (the 70K bunny 4.55, QuadWild's joint 3.42); a
+  //! vertex order mapped onto merged unknowns it did not place gave 15.8 on the pig (AMD: 1.22).
+  static constexpr double kSuspiciousFillPerNonzero = 8.0;
   void set_ordering_hint(std::vector<int> ordering);
 
  private:
@@ -96,6 +105,8 @@ class SpdSolver {
   struct AnalysisResult {
     double seconds = 0;
     bool hinted = false;
+    bool rejected_hint = false;
+    double factor_nonzeros = 0;
   };
   //! The symbolic analysis of \p A into \p impl (its state replaced); \p hint: the ordering to
   //! use (empty: CHOLMOD's). \throw SolverError when CHOLMOD fails.
