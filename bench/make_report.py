@@ -245,7 +245,7 @@ def main():
           "described here. Re-run the command to regenerate this page, `out/bench/results.json` "
           "and `docs/bench/*.svg`. Not part of the test suite.", "",
           "## Machine and run", "",
-          f"- CPUs (`nproc`): {machine['nproc']}",
+          f"- CPUs (`nproc --all`): {machine['nproc']}",
           f"- CPU model (`lscpu`): {machine['cpu']}",
           f"- Memory: {machine['memory']}",
           f"- Load average at the end of the run: {machine['load']} (the machine is shared: "

@@ -13,7 +13,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
-command_line="$( (env | grep -E '^QS_(BENCH_[A-Z_]+|SHARED_DIR)=' || true) | sort | tr '\n' ' ')scripts/bench.sh $*"
+command_line="$( (env | grep -E '^(QS_(BENCH_[A-Z_]+|SHARED_DIR)|OMP_NUM_THREADS|OMP_THREAD_LIMIT|OPENBLAS_NUM_THREADS)=' || true) | sort | tr '\n' ' ')scripts/bench.sh $*"
 models="ellipsoid spot fandisk pig cow cat joint"
 steps=10
 micro=1
@@ -57,7 +57,7 @@ else
 fi
 targets=(quadsketch-cli)
 [ "$micro" = 1 ] && targets+=(qs_micro_bench qs_bench_gradient)
-[ "$do_build" = 1 ] && cmake --build "$build" -j"$(nproc)" --target "${targets[@]}"
+[ "$do_build" = 1 ] && cmake --build "$build" -j"$(nproc --all)" --target "${targets[@]}"
 cli="$(cd "$build" && pwd)/app/quadsketch-cli"
 
 mkdir -p "$out"
@@ -172,7 +172,7 @@ def sh(c):
     except Exception:
         return ""
 print(json.dumps({
-    "nproc": sh("nproc"),
+    "nproc": sh("nproc --all"),
     "cpu": sh("lscpu | grep 'Model name' | sed 's/Model name: *//'"),
     "memory": sh("free -h | awk '/^Mem:/ {print $2}'"),
     "load": sh("cut -d' ' -f1-3 /proc/loadavg"),
