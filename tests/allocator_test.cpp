@@ -3,9 +3,14 @@
 
 #include <gtest/gtest.h>
 
+#include <condition_variable>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <mutex>
 #include <string>
+#include <thread>
+#include <vector>
 
 #if defined(__GLIBC__)
 #include <malloc.h>
@@ -50,6 +55,57 @@ TEST(Allocator, KeepsFreedSolverSizedBlocks) {
   EXPECT_LT(mallinfo2().hblkhd, mapped_before + kBytes) << "the block was mmap()ed";
   std::free(block);
   EXPECT_GE(mallinfo2().fordblks, kBytes) << "the freed block went back to the kernel";
+#endif
+}
+
+#if defined(__GLIBC__) && !defined(QS_SANITIZED_MALLOC)
+// The arenas malloc_info() lists (one <heap nr="…"> element each).
+int malloc_arenas() {
+  char* text = nullptr;
+  size_t size = 0;
+  FILE* f = open_memstream(&text, &size);
+  if (!f) return -1;
+  malloc_info(0, f);
+  std::fclose(f);
+  int n = 0;
+  for (const char* p = text; (p = std::strstr(p, "<heap nr=")) != nullptr; ++p) ++n;
+  std::free(text);
+  return n;
+}
+#endif
+
+// Threads that allocate while all of them are alive share at most kept_memory_arena_limit()
+// arenas (glibc alone would give each of them its own, up to 8 per core), so the memory each
+// arena keeps for reuse is not multiplied by the solver threads.
+TEST(Allocator, ThreadsShareTheLimitedArenas) {
+#if !defined(__GLIBC__) || defined(QS_SANITIZED_MALLOC)
+  GTEST_SKIP() << "glibc's malloc only (sanitizers replace it)";
+#else
+  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  if (tunables && std::strstr(tunables, "glibc.malloc."))
+    GTEST_SKIP() << "GLIBC_TUNABLES sets malloc tunables: the policy leaves them alone";
+  ASSERT_TRUE(keep_freed_memory());
+  const int limit = kept_memory_arena_limit();
+  ASSERT_GE(limit, 2);
+  const int threads = limit + 4;
+  std::mutex m;
+  std::condition_variable cv;
+  int allocated = 0;
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t)
+    pool.emplace_back([&] {
+      void* p = touched_block(1 << 16);
+      std::unique_lock<std::mutex> lock(m);
+      ++allocated;
+      cv.notify_all();
+      cv.wait(lock, [&] { return allocated == threads; });  // all alive, each with its block
+      lock.unlock();
+      std::free(p);
+    });
+  for (auto& t : pool) t.join();
+  const int arenas = malloc_arenas();
+  EXPECT_GE(arenas, 1);
+  EXPECT_LE(arenas, limit) << threads << " threads";
 #endif
 }
 

@@ -9,15 +9,24 @@
 // removes both: on the 70K bunny, `optimize` took 71 s instead of 84 s with parallel hops
 // (the hop sweeps 12–13 s instead of 16–18 s each, kernel time 3.8 s instead of 16 s).
 // The price is a resident size that does not shrink after a large solve (up to the trim
-// threshold of free memory is kept).
+// threshold of free memory is kept, per malloc arena). glibc gives threads up to 8 arenas per
+// core; the policy allows one per hardware thread, so the kept memory does not multiply with
+// the solver threads that come and go: the pig of `import-quads --refine 3`, displaced and
+// optimized, peaked at 3.1 GB resident with glibc's arena count and 2.1 GB with two arenas
+// (2.1 GB with glibc's defaults altogether: its live peak), the 150-patch bunny at 1.63 and
+// 1.45 GB, in the same time (docs/benchmarks.md, session 25).
 #pragma once
 
 namespace qs {
 
 //! glibc: mallopt() with an mmap threshold of 32 MB (glibc's maximum; larger blocks still get
-//! their own mmap), a trim threshold of 1 GB and a top pad of 256 MB. Leaves the allocator
-//! alone when GLIBC_TUNABLES sets any glibc.malloc tunable (the user's choice wins) and on
-//! other C libraries. \return true when the policy was applied.
+//! their own mmap), a trim threshold of 1 GB, a top pad of 256 MB and at most
+//! kept_memory_arena_limit() arenas. Leaves the allocator alone when GLIBC_TUNABLES sets any
+//! glibc.malloc tunable (the user's choice wins) and on other C libraries. \return true when the
+//! policy was applied.
 bool keep_freed_memory();
+
+//! The policy's arena count: one per hardware thread, at least 2.
+int kept_memory_arena_limit();
 
 }  // namespace qs
