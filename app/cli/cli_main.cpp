@@ -122,10 +122,12 @@ int main(int argc, char** argv) {
   auto* sizing_on = cmd_opt->add_flag_callback(
       "--sizing", [&opt] { opt.sizing = true; },
       "Scale the parameterization's targets by the curl-reducing sizing field (paper §5.3; "
-      "off by default)");
+      "off by default, but without --sizing or --no-sizing a node optimization that ends "
+      "with fold-overs is run again with it and kept when it has fewer)");
   cmd_opt
       ->add_flag_callback(
-          "--no-sizing", [&opt] { opt.sizing = false; }, "Unit targets, no sizing field (default)")
+          "--no-sizing", [&opt] { opt.sizing = false; },
+          "Unit targets, no sizing field, and no retry with it when fold-overs remain")
       ->excludes(sizing_on);
   cmd_opt->add_option("--sharp-angle", opt.sharp_angle_deg, "Sharp feature dihedral angle (deg)")
       ->capture_default_str();

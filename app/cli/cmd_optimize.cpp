@@ -159,9 +159,48 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       options.param.orientation.enabled = true;
       options.param.orientation.observer = &printer;
     }
+    // The sizing retry: when the user left the sizing field to the default (off) and fold-overs
+    // remain after the node optimization's fold-over removal, the layout is optimized again
+    // from the input with the sizing field, and that run is taken when it ends with fewer
+    // fold-overs (the rocker-arm cage layout: 81 without, 0 with; docs/benchmarks.md sessions
+    // 24-25). An explicit --sizing or --no-sizing decides up front; --no-orientation (stiffening
+    // only, an ablation) and the discrete baseline are run as asked.
+    nlohmann::json sizing_retry;
     if (!o.no_node_opt) {
       t0 = std::chrono::steady_clock::now();
+      const bool may_retry =
+          !o.sizing && !o.discrete_relocation && !o.no_orientation && !options.param.sizing.enabled;
+      std::optional<TriMesh> input_mesh;
+      std::optional<Layout> input_layout;
+      if (may_retry) input_mesh = mesh, input_layout = layout;
+      const PipelineOptions input_options = options;
       adopt(optimize(mesh, layout, options));
+      if (may_retry && node_result->foldovers_final > 0 && !node_result->stopped) {
+        if (!common.quiet)
+          std::cerr << "optimize: " << node_result->foldovers_final
+                    << " fold-over(s) remain; optimizing again from the input with the sizing "
+                       "field (--sizing or --no-sizing decides this up front)\n";
+        const auto t_retry = std::chrono::steady_clock::now();
+        PipelineOptions sized = input_options;
+        sized.param.sizing.enabled = true;
+        NodeOptResult second = optimize(*input_mesh, *input_layout, sized);
+        const bool better = second.foldovers_final < node_result->foldovers_final;
+        sizing_retry = {{"foldovers_without", node_result->foldovers_final},
+                        {"E_final_without", node_result->E_final},
+                        {"foldovers_with", second.foldovers_final},
+                        {"E_final_with", second.E_final},
+                        {"used", better},
+                        {"time_s", seconds_since(t_retry)}};
+        if (!common.quiet)
+          std::cerr << "optimize: with the sizing field " << second.foldovers_final
+                    << " fold-over(s) remain (" << node_result->foldovers_final
+                    << " without): " << (better ? "using it" : "keeping the run without it")
+                    << "\n";
+        if (better) {
+          options = sized;
+          adopt(std::move(second));
+        }
+      }
       node_s = seconds_since(t0);
     }
     // --integer (paper §8): round every arc's length on the relaxed result to a multiple of Q
@@ -265,6 +304,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
                                                                 : "none"},
           {"orientation", orientation_json(node_result->orientation)},
           {"time_limited", time_limited}};
+      if (!sizing_retry.is_null()) report["node_optimization"]["sizing_retry"] = sizing_retry;
       warn_about_infeasible_orientation(node_result->orientation, param.foldovers, pipeline.mesh(),
                                         pipeline.layout());
     }
