@@ -178,6 +178,31 @@ TEST(GuiJob, WrapFreeHolesReachesTheField) {
   EXPECT_GT(wrapped->metrics.foldovers, 0);
 }
 
+// A Run that ends with fold-overs with the sizing field off says so and offers the sizing
+// field (what `quadsketch-cli optimize` retries with by itself); with it on, no such offer. The
+// case: the flat square whose free hole the field wraps ("Wrap free holes"), which folds
+// wherever the nodes go.
+TEST(GuiJob, RunEndingWithFoldOversOffersTheSizingField) {
+  const test::MeshAndLayout sq = test::flat_square_with_free_hole();
+  const Example ex{std::make_shared<const TriMesh>(sq.mesh), sq.layout};
+  WorkerOptions options;
+  options.align = false;
+  options.wrap_free_holes = true;
+  ASSERT_TRUE(options.node_optimization);
+  ASSERT_FALSE(options.sizing);
+  const auto plain = test::run_job(ex, options);
+  ASSERT_EQ(plain->status, WorkerStatus::Finished) << plain->message;
+  ASSERT_GT(plain->metrics.foldovers, 0) << "the case must fold: " << plain->message;
+  std::printf("[stat] %s\n", plain->message.c_str());
+  EXPECT_NE(plain->message.find("fold-over(s) remain: turn on 'Sizing field' and Run again"),
+            std::string::npos)
+      << plain->message;
+  options.sizing = true;
+  const auto sized = test::run_job(ex, options);
+  ASSERT_EQ(sized->status, WorkerStatus::Finished) << sized->message;
+  EXPECT_EQ(sized->message.find("turn on 'Sizing field'"), std::string::npos) << sized->message;
+}
+
 // "Sizing field" (WorkerOptions::sizing) reaches the parameterization: on the bundled sketch
 // with fixed nodes the sized targets give a lower residual and no fold-over (as `optimize
 // --no-node-opt --sizing`), while the default unit targets fold.

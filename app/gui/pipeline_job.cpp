@@ -304,6 +304,11 @@ StepResult pipeline_step(WorkerState& state, const WorkerObserver& observer) {
         if (!near.empty()) prefix += " (infeasible near " + describe_nodes(job->layout, near) + ")";
       }
     }
+    // What `quadsketch-cli optimize` does by itself in this case (its sizing retry), offered.
+    if (end.foldovers_final > 0 && !state.options.sizing)
+      prefix += std::string(prefix.empty() ? "" : "; ") + std::to_string(end.foldovers_final) +
+                " fold-over(s) remain: turn on 'Sizing field' and Run again (the command line "
+                "retries with it by itself)";
     const double nodeopt_ms = ms_since(t);
     result = solve_for_display(*job, state, observer, true);
     result.metrics.nodeopt_ms = nodeopt_ms;
