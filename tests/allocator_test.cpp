@@ -36,6 +36,12 @@ void* touched_block(size_t bytes) {
   if (v) v[bytes - 1] = 2;
   return p;
 }
+
+// Does the environment set glibc malloc tunables (then the policy is not applied)?
+bool user_sets_malloc_tunables() {
+  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  return tunables && std::strstr(tunables, "glibc.malloc.");
+}
 #endif
 
 // Under glibc's defaults a 20 MB block is a fresh mmap() and goes back to the kernel when
@@ -44,8 +50,7 @@ TEST(Allocator, KeepsFreedSolverSizedBlocks) {
 #if !defined(__GLIBC__) || defined(QS_SANITIZED_MALLOC)
   GTEST_SKIP() << "glibc's malloc only (sanitizers replace it)";
 #else
-  const char* tunables = std::getenv("GLIBC_TUNABLES");
-  if (tunables && std::strstr(tunables, "glibc.malloc."))
+  if (user_sets_malloc_tunables())
     GTEST_SKIP() << "GLIBC_TUNABLES sets malloc tunables: the policy leaves them alone";
   ASSERT_TRUE(keep_freed_memory());
   constexpr size_t kBytes = 20u << 20;
@@ -81,8 +86,7 @@ TEST(Allocator, ThreadsShareTheLimitedArenas) {
 #if !defined(__GLIBC__) || defined(QS_SANITIZED_MALLOC)
   GTEST_SKIP() << "glibc's malloc only (sanitizers replace it)";
 #else
-  const char* tunables = std::getenv("GLIBC_TUNABLES");
-  if (tunables && std::strstr(tunables, "glibc.malloc."))
+  if (user_sets_malloc_tunables())
     GTEST_SKIP() << "GLIBC_TUNABLES sets malloc tunables: the policy leaves them alone";
   ASSERT_TRUE(keep_freed_memory());
   const int limit = kept_memory_arena_limit();
