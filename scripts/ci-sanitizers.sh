@@ -2,7 +2,8 @@
 # Sanitizer CI (issue #10): every unit test under ASan+UBSan (build-asan, no GUI), the
 # threading tests (worker, SpdSolver, the parameterization's second thread, the parameterization
 # set up beside the field) under TSan
-# (build-tsan). Tests labelled "slow" are left out.
+# (build-tsan). Tests labelled "slow" are left out; the benchmark executables are not built
+# (nothing of the test suite runs them; the main build compiles them).
 # Usage: scripts/ci-sanitizers.sh [asan|tsan]...   (default: both)
 # QS_SANITIZER_BUILD_ROOT puts the build folders elsewhere (default: the repository).
 set -euo pipefail
@@ -24,7 +25,8 @@ configure() {  # dir, extra cmake args
   local dir="$1"
   shift
   if [ ! -f "$dir/CMakeCache.txt" ]; then
-    cmake -S . -B "$dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DQS_BUILD_APP=OFF "$@"
+    cmake -S . -B "$dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DQS_BUILD_APP=OFF \
+      -DQS_BUILD_BENCH=OFF "$@"
   else
     cmake -S . -B "$dir" "$@" >/dev/null
   fi
