@@ -215,17 +215,17 @@ int main(int argc, char** argv) {
         std::printf("  unit factorize+solve, best of 3: upper triangle %.4f, lower %.4f\n",
                     best_upper, best);
       }
+      const qs::SpdSolverStats& order_stats = solver.linear_solver().stats();
       std::printf(
           "stage %.4f = solver %.4f (setup %.4f assemble %.4f analyze %.4f factorize %.4f "
           "solve %.4f wall) + trace %.4f; unit %.4f (analyze %.4f) ratio %.2f | unknowns %d "
           "nnz(A) %ld nnz(L) %.0f (%s) E %.12g foldovers %d structurally_equivalent %d%s\n",
           stage, solve, res.timings.setup_s, res.timings.assemble_s, res.timings.analyze_s,
           res.timings.factorize_s, res.timings.solve_s, trace, unit, analyze, stage / unit,
-          res.unknowns, static_cast<long>(A.nonZeros()),
-          solver.linear_solver().stats().factor_nonzeros,
-          solver.linear_solver().stats().rejected_hints    ? "vertex order rejected"
-          : solver.linear_solver().stats().hinted_analyses ? "vertex order"
-                                                           : "CHOLMOD's ordering",
+          res.unknowns, static_cast<long>(A.nonZeros()), order_stats.factor_nonzeros,
+          order_stats.rejected_hints    ? "vertex order rejected"
+          : order_stats.hinted_analyses ? "vertex order"
+                                        : "CHOLMOD's ordering",
           res.energy, res.foldovers, ex.structurally_equivalent ? 1 : 0,
           x.allFinite() ? "" : " (unit solve failed)");
       if (detail) {
