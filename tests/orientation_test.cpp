@@ -125,6 +125,75 @@ TEST(OrientationQp, NoFoldsReturnsTheUnconstrainedSolution) {
   EXPECT_EQ((y - b).norm(), 0.0);
 }
 
+// solution_frame_angles on a flat fan of six triangles, each with its own three wedges, whose
+// field runs along the global x axis (θ_f in each face's own 2D frame) and whose map is the
+// global (x, y) turned by φ and scaled by 2: every face's rotation from the field to the map is
+// φ, so its Q_k at the returned angle are parallel to its corner offsets. One face mirrored
+// (folded) takes its neighbours' rotation φ; with every face folded, the field frame stays.
+TEST(OrientationQp, SolutionFrameTurnsTheSectorsWithTheMap) {
+  TriMesh mesh;
+  const auto center = mesh.add_vertex(Vec3(0, 0, 0));
+  std::vector<TriMesh::VertexHandle> rim;
+  for (int k = 0; k < 6; ++k)
+    rim.push_back(mesh.add_vertex(Vec3(std::cos(k * M_PI / 3), 0.8 * std::sin(k * M_PI / 3), 0)));
+  for (int k = 0; k < 6; ++k) mesh.add_face(center, rim[k], rim[(k + 1) % 6]);
+  const GeometryCache g = build_geometry(mesh);
+  const int nf = g.n_faces;
+  const double phi = 0.7;
+  std::vector<double> theta(nf);
+  std::vector<int> corner_wedge(3 * nf);
+  Eigen::VectorXd x(6 * nf);
+  for (int f = 0; f < nf; ++f) {
+    const auto p = face_corners_2d(mesh, g, f);
+    const Vec3 a = mesh.point(mesh.vertex_handle(g.face_vertices[f][0]));
+    const Vec3 b = mesh.point(mesh.vertex_handle(g.face_vertices[f][1]));
+    // The face frame's angle α_f in the global plane; the global x axis is at −α_f in it.
+    const double alpha =
+        std::atan2(b[1] - a[1], b[0] - a[0]) - std::atan2(p[1][1] - p[0][1], p[1][0] - p[0][0]);
+    theta[f] = -alpha;
+    for (int k = 0; k < 3; ++k) {
+      corner_wedge[3 * f + k] = 3 * f + k;
+      const Vec3 q = mesh.point(mesh.vertex_handle(g.face_vertices[f][k]));
+      x(2 * (3 * f + k)) = 2 * (std::cos(phi) * q[0] - std::sin(phi) * q[1]);
+      x(2 * (3 * f + k) + 1) = 2 * (std::sin(phi) * q[0] + std::cos(phi) * q[1]);
+    }
+  }
+  auto turn = [](double a) { return std::remainder(a, 2 * M_PI); };
+  {
+    const std::vector<double> t = solution_frame_angles(mesh, g, theta, corner_wedge, x);
+    ASSERT_EQ(static_cast<int>(t.size()), nf);
+    const auto ideal = ideal_corner_offsets(mesh, g, t);
+    for (int f = 0; f < nf; ++f) {
+      EXPECT_NEAR(turn(t[f] - theta[f] + phi), 0.0, 1e-12) << "face " << f;
+      const Eigen::Vector2d c =
+          (x.segment<2>(6 * f) + x.segment<2>(6 * f + 2) + x.segment<2>(6 * f + 4)) / 3;
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector2d d = x.segment<2>(2 * (3 * f + k)) - c;
+        const Eigen::Vector2d q(ideal[f][k][0], ideal[f][k][1]);
+        EXPECT_NEAR(d.x() * q.y() - d.y() * q.x(), 0.0, 1e-12 * d.norm() * q.norm());
+        EXPECT_GT(d.dot(q), 0.0);
+      }
+    }
+    // The field frame's own sectors are turned by −φ against the map.
+    const auto field = ideal_corner_offsets(mesh, g, theta);
+    const Eigen::Vector2d d =
+        x.segment<2>(0) - (x.segment<2>(0) + x.segment<2>(2) + x.segment<2>(4)) / 3;
+    EXPECT_NEAR(std::atan2(d.y(), d.x()) - std::atan2(field[0][0][1], field[0][0][0]), phi, 1e-12);
+  }
+  // Face 2 mirrored across its first corner's u: folded; it takes φ from faces 1 and 3.
+  Eigen::VectorXd folded = x;
+  for (int k = 0; k < 3; ++k) folded(2 * (6 + k)) = 2 * x(2 * 6) - x(2 * (6 + k));
+  ASSERT_EQ(count_foldovers(corner_wedge, folded), 1);
+  const std::vector<double> t = solution_frame_angles(mesh, g, theta, corner_wedge, folded);
+  for (int f = 0; f < nf; ++f) EXPECT_NEAR(turn(t[f] - theta[f] + phi), 0.0, 1e-12) << f;
+  // Every face folded: nothing to take a rotation from.
+  Eigen::VectorXd all = x;
+  for (int c = 0; c < 3 * nf; ++c) all(2 * c) = -x(2 * c);
+  ASSERT_EQ(count_foldovers(corner_wedge, all), nf);
+  EXPECT_EQ(solution_frame_angles(mesh, g, theta, corner_wedge, all), theta);
+  EXPECT_THROW(solution_frame_angles(mesh, g, theta, corner_wedge, x.head(4)), InvalidInputError);
+}
+
 // ---------------------------------------------------------------------------------------------
 // (b) the constrained parameterization keeps every equality constraint exact
 
@@ -572,6 +641,9 @@ TEST(OrientationRealData, StopsWhenEveryFaceIsInfeasible) {
   options.param.orientation.enabled = true;
   options.param.orientation.rings = 0;
   options.param.orientation.all_faces_after_rounds = 1;
+  // The scenario needs the field frame's sectors: with the solution frame (the default) the
+  // first round is already infeasible there.
+  options.param.orientation.sector_frame = SectorFrame::kField;
   OrientationReport report[2];
   for (int stop = 0; stop < 2; ++stop) {
     options.param.orientation.stop_if_all_faces_infeasible = stop != 0;
@@ -634,6 +706,7 @@ TEST(OrientationQp, StopsWhenEveryFaceIsInfeasible) {
   OrientationOptions o;
   o.rings = 0;
   o.all_faces_after_rounds = 1;
+  o.sector_frame = SectorFrame::kField;  // the rounds of one frame (no second attempt)
   OrientationReport report[2];
   Eigen::VectorXd y[2];
   for (int stop = 0; stop < 2; ++stop) {

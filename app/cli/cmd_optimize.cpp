@@ -52,6 +52,7 @@ nlohmann::json orientation_json(const OrientationReport& r) {
           {"rounds", r.rounds},
           {"iterations", r.iterations},
           {"time_s", r.time_s},
+          {"sector_frame", r.sector_frame == SectorFrame::kSolution ? "solution" : "field"},
           {"message", r.message},
           {"infeasible_faces", r.infeasible_faces}};
 }

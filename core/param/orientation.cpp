@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <complex>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -448,6 +449,56 @@ IpmOutcome interior_point_dual(const Eigen::MatrixXd& S, const Eigen::VectorXd& 
   return out;
 }
 
+// solution_frame_angles (header) with the face adjacency at hand.
+std::vector<double> map_frame_angles(const TriMesh& mesh, const GeometryCache& g,
+                                     const std::vector<double>& theta,
+                                     const std::vector<int>& corner_wedge, const Eigen::VectorXd& x,
+                                     const std::vector<std::vector<int>>& nbr) {
+  const int nf = g.n_faces;
+  std::vector<double> out(theta);
+  // Unit complex e^{iδ} of the rotation from the field frame to the map's closest rotation.
+  std::vector<std::complex<double>> rot(nf, 0.0);
+  std::vector<char> known(nf, 0);
+  for (int f = 0; f < nf; ++f) {
+    const auto p = face_corners_2d(mesh, g, f);
+    Eigen::Matrix2d E, P;
+    for (int k = 1; k < 3; ++k) {
+      E.col(k - 1) = Vec2(p[k][0] - p[0][0], p[k][1] - p[0][1]);
+      const int w = corner_wedge[3 * f + k], w0 = corner_wedge[3 * f];
+      P.col(k - 1) = Vec2(x(2 * w) - x(2 * w0), x(2 * w + 1) - x(2 * w0 + 1));
+    }
+    if (!(E.determinant() > 0) || !(P.determinant() > 0)) continue;
+    const Eigen::Matrix2d J = P * E.inverse();
+    // Closest rotation R(ψ) to J; the frame (cos θ', sin θ') maps q to R(−θ')q, so θ' = −ψ.
+    const double psi = std::atan2(J(1, 0) - J(0, 1), J(0, 0) + J(1, 1));
+    rot[f] = std::polar(1.0, -psi - theta[f]);
+    known[f] = 1;
+  }
+  // Folded or degenerate faces: the mean rotation of known neighbours, ring by ring.
+  std::vector<int> frontier;
+  for (int f = 0; f < nf; ++f)
+    if (!known[f]) frontier.push_back(f);
+  while (!frontier.empty()) {
+    std::vector<int> next;
+    std::vector<std::pair<int, std::complex<double>>> fill;
+    for (int f : frontier) {
+      std::complex<double> sum = 0.0;
+      for (int n : nbr[f])
+        if (known[n]) sum += rot[n];
+      if (std::abs(sum) > 1e-12)
+        fill.emplace_back(f, sum / std::abs(sum));
+      else
+        next.push_back(f);
+    }
+    if (fill.empty()) break;  // components without any known face keep the field frame
+    for (const auto& [f, r] : fill) rot[f] = r, known[f] = 1;
+    frontier.swap(next);
+  }
+  for (int f = 0; f < nf; ++f)
+    if (known[f]) out[f] = theta[f] + std::arg(rot[f]);
+  return out;
+}
+
 }  // namespace
 
 std::vector<std::array<std::array<double, 2>, 3>> ideal_corner_offsets(
@@ -468,6 +519,19 @@ std::vector<std::array<std::array<double, 2>, 3>> ideal_corner_offsets(
   return out;
 }
 
+std::vector<double> solution_frame_angles(const TriMesh& mesh, const GeometryCache& g,
+                                          const std::vector<double>& theta,
+                                          const std::vector<int>& corner_wedge,
+                                          const Eigen::VectorXd& x) {
+  if (static_cast<int>(theta.size()) != g.n_faces ||
+      static_cast<int>(corner_wedge.size()) != 3 * g.n_faces)
+    throw InvalidInputError("solution_frame_angles: inconsistent sizes");
+  for (int w : corner_wedge)
+    if (w < 0 || 2 * static_cast<Eigen::Index>(w) + 1 >= x.size())
+      throw InvalidInputError("solution_frame_angles: corner wedge out of range");
+  return map_frame_angles(mesh, g, theta, corner_wedge, x, face_neighbours(g));
+}
+
 int count_foldovers(const std::vector<int>& corner_wedge, const Eigen::VectorXd& x,
                     std::vector<char>* folded) {
   const int nf = static_cast<int>(corner_wedge.size() / 3);
@@ -485,32 +549,21 @@ int count_foldovers(const std::vector<int>& corner_wedge, const Eigen::VectorXd&
   return count;
 }
 
-Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& g,
-                               const std::vector<double>& theta,
+namespace {
+
+// solve_oriented with the sectors of the frame angles \p sector_theta (its inputs checked; y0
+// folds). Fills \p rep from scratch except ran/foldovers_before.
+Eigen::VectorXd solve_in_frame(const TriMesh& mesh, const GeometryCache& g,
+                               const std::vector<double>& sector_theta,
                                const std::vector<int>& corner_wedge, const Reduction& red,
                                const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
                                const Eigen::VectorXd& y0, const OrientationOptions& o,
-                               OrientationReport* report, SpdSolver* factorized_A,
-                               const std::vector<int>* ordering) {
+                               const std::vector<char>& folded,
+                               const std::vector<std::vector<int>>& nbr, OrientationReport& rep,
+                               SpdSolver* factorized_A, const std::vector<int>* ordering) {
   const auto t0 = std::chrono::steady_clock::now();
-  OrientationReport local;
-  OrientationReport& rep = report ? *report : local;
-  rep = OrientationReport{};
-  rep.ran = true;
-  if (static_cast<int>(corner_wedge.size()) != 3 * g.n_faces ||
-      static_cast<int>(theta.size()) != g.n_faces || y0.size() != A.cols() ||
-      b.size() != A.rows() || red.Z.cols() != A.cols())
-    throw InvalidInputError("orientation constraints: inconsistent problem sizes");
-  if (!(o.margin > 0) || o.rings < 0 || o.max_rounds < 1 || o.max_iterations < 1)
-    throw InvalidInputError("orientation constraints: invalid options");
-
-  std::vector<char> folded;
-  rep.foldovers_before = count_foldovers(corner_wedge, red.Z * y0 + red.z0, &folded);
   rep.foldovers_after = rep.foldovers_before;
-  if (rep.foldovers_before == 0) return y0;
-
-  const auto ideal = ideal_corner_offsets(mesh, g, theta);
-  const auto nbr = face_neighbours(g);
+  const auto ideal = ideal_corner_offsets(mesh, g, sector_theta);
   const double h = g.mean_edge_length > 0 ? g.mean_edge_length : 1.0;
   // Scaled objective (A/h, b/h): residuals and multipliers of order one.
   const Eigen::SparseMatrix<double> As = A / h;
@@ -621,6 +674,108 @@ Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& g,
   }
   rep.time_s = seconds_since(t0);
   return y;
+}
+
+// Adds the effort of another attempt to \p into (its counts, its time).
+void add_effort(OrientationReport& into, const OrientationReport& other) {
+  into.rounds += other.rounds;
+  into.iterations += other.iterations;
+  into.sparse_factorizations += other.sparse_factorizations;
+  into.ordered_rounds += other.ordered_rounds;
+  into.time_s += other.time_s;
+}
+
+}  // namespace
+
+Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& g,
+                               const std::vector<double>& theta,
+                               const std::vector<int>& corner_wedge, const Reduction& red,
+                               const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
+                               const Eigen::VectorXd& y0, const OrientationOptions& o,
+                               OrientationReport* report, SpdSolver* factorized_A,
+                               const std::vector<int>* ordering) {
+  OrientationReport local;
+  OrientationReport& rep = report ? *report : local;
+  rep = OrientationReport{};
+  rep.ran = true;
+  if (static_cast<int>(corner_wedge.size()) != 3 * g.n_faces ||
+      static_cast<int>(theta.size()) != g.n_faces || y0.size() != A.cols() ||
+      b.size() != A.rows() || red.Z.cols() != A.cols())
+    throw InvalidInputError("orientation constraints: inconsistent problem sizes");
+  if (!(o.margin > 0) || o.rings < 0 || o.max_rounds < 1 || o.max_iterations < 1)
+    throw InvalidInputError("orientation constraints: invalid options");
+
+  std::vector<char> folded;
+  const Eigen::VectorXd x0 = red.Z * y0 + red.z0;
+  rep.foldovers_before = count_foldovers(corner_wedge, x0, &folded);
+  rep.foldovers_after = rep.foldovers_before;
+  if (rep.foldovers_before == 0) return y0;
+  const auto nbr = face_neighbours(g);
+  const int foldovers_before = rep.foldovers_before;
+  auto attempt = [&](SectorFrame frame, OrientationReport& r) {
+    r = OrientationReport{};
+    r.ran = true;
+    r.foldovers_before = foldovers_before;
+    r.sector_frame = frame;
+    const std::vector<double> sector_theta =
+        frame == SectorFrame::kSolution ? map_frame_angles(mesh, g, theta, corner_wedge, x0, nbr)
+                                        : theta;
+    return solve_in_frame(mesh, g, sector_theta, corner_wedge, red, A, b, y0, o, folded, nbr, r,
+                          factorized_A, ordering);
+  };
+  if (o.sector_frame == SectorFrame::kField) return attempt(SectorFrame::kField, rep);
+
+  // Solution-frame sectors first; where fold-overs remain (or the QP is infeasible), the
+  // field frame's sectors too, and the attempt with fewer fold-overs is kept (ties: the first).
+  OrientationReport first;
+  Eigen::VectorXd y_first;
+  std::string first_error;
+  try {
+    y_first = attempt(SectorFrame::kSolution, first);
+    if (first.foldovers_after == 0) {
+      rep = first;
+      return y_first;
+    }
+  } catch (const SolverError& e) {
+    first_error = e.what();
+    if (first.message.empty()) first.message = first_error;
+  }
+  const std::string first_account =
+      "solution-frame sectors: " +
+      (first.message.empty() ? std::to_string(first.foldovers_after) + " fold-over(s) remain"
+                             : first.message);
+  OrientationReport second;
+  Eigen::VectorXd y_second;
+  try {
+    y_second = attempt(SectorFrame::kField, second);
+  } catch (const SolverError& e) {
+    if (second.message.empty()) second.message = e.what();
+    if (!first_error.empty()) {  // neither frame gave a solution
+      rep = second;
+      add_effort(rep, first);
+      rep.message = "field-frame sectors: " + second.message + "; " + first_account;
+      throw SolverError(rep.message);
+    }
+    rep = first;
+    add_effort(rep, second);
+    rep.message =
+        (rep.message.empty() ? std::to_string(rep.foldovers_after) + " fold-over(s) remain"
+                             : rep.message) +
+        "; field-frame sectors: " + second.message;
+    return y_first;
+  }
+  if (first_error.empty() && first.foldovers_after <= second.foldovers_after) {
+    rep = first;
+    add_effort(rep, second);
+    if (!second.message.empty()) rep.message += "; field-frame sectors: " + second.message;
+    return y_first;
+  }
+  rep = second;
+  add_effort(rep, first);
+  rep.message = (rep.message.empty() ? std::string("field-frame sectors used")
+                                     : "field-frame sectors: " + rep.message) +
+                " (" + first_account + ")";
+  return y_second;
 }
 
 }  // namespace qs

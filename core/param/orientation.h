@@ -40,6 +40,21 @@
 // primal problem, each iteration factorizing A + Cᵀdiag(λ/s)C with CHOLMOD (one symbolic analysis
 // per active set).
 //
+// Sector frame (OrientationOptions::sector_frame). The rays need not come from the field frame:
+// any three sectors in ccw order, each narrower than π, make the condition above sufficient.
+// By default each face's Q_k are rotated by the rotation closest to the unconstrained solution's
+// Jacobian on that face (its polar factor; folded and degenerate faces take the mean rotation of
+// their neighbours, ring by ring), so the sectors sit where the solution already puts the
+// corners. Where the layout makes the map turn away from the field (the arcs leave the field's
+// directions near crowded nodes), field-frame sectors ask each face to turn back, which together
+// with the iso-line constraints can be infeasible: spot's displaced imported layout
+// (perturb --rings 2 --seed 1) ends with 4 fold-overs with field-frame sectors and 0 with these.
+// Neither frame contains the other's feasible set, so where fold-overs remain with the solution
+// frame (or its QP is infeasible), the field frame's QP is solved as well and the solution with
+// fewer fold-overs kept (inspired_mesh's coarsened layout with split constraint clusters: 2
+// fold-overs left with the solution frame, 0 with the field frame); the report's counts and time
+// then cover both attempts.
+//
 // Active set. Only faces that need it are constrained: the folded faces of the unconstrained
 // solution and `rings` rings of neighbours around them; when the constrained solution folds
 // other faces, those (and their rings) are added and the QP re-solved (at most max_rounds).
@@ -58,10 +73,17 @@
 
 namespace qs {
 
+//! Which frame the tri-sector rays are built in (see "Sector frame" above).
+enum class SectorFrame {
+  kField,     //!< the field frame (u_t, v_t) of each face (algorithm.md §7.2 as written)
+  kSolution,  //!< the field frame turned by the unconstrained solution's rotation on the face
+};
+
 struct OrientationOptions {
   //! Apply the constraints in the parameterization solve when it has fold-overs
   //! (ParamOptions::orientation; the node optimizer enables it for its last solve).
   bool enabled = false;
+  SectorFrame sector_frame = SectorFrame::kSolution;  //!< the frame of the tri-sector rays
   int rings = 2;            //!< neighbour rings (across edges) added around each folded face
   int max_rounds = 5;       //!< active-set growth rounds (QP solves) at most
   int max_iterations = 60;  //!< interior-point iterations per QP at most (one factorization each)
@@ -113,6 +135,8 @@ struct OrientationReport {
   bool dense = false;                          //!< the last round used the dense dual solver
   double energy_before = 0, energy_after = 0;  //!< value of the (weighted) energy (1)
   double time_s = 0;
+  //! The frame of the sectors of the returned solution (kSolution: field frame not needed).
+  SectorFrame sector_frame = SectorFrame::kField;
   std::string message;  //!< why it failed, if it did
   //! When the last round was infeasible: the constrained faces its last iterate violates most
   //! (at most 5, worst first; also named in \ref message), where the layout cannot unfold.
@@ -123,6 +147,17 @@ struct OrientationReport {
 //! units; all zero for a degenerate face. Size #F.
 std::vector<std::array<std::array<double, 2>, 3>> ideal_corner_offsets(
     const TriMesh& mesh, const GeometryCache& geometry, const std::vector<double>& theta);
+
+//! Frame angles (radians, per face, size #F) for ideal_corner_offsets that turn each face's
+//! field frame \p theta by the rotation closest to the map \p x on it (x: 2 values (u, v) per
+//! wedge; \p corner_wedge: size 3·#F): for a map that is a rotation times a scale on a face,
+//! the face's Q_k are then parallel to its corner offsets. Faces the map folds or collapses
+//! take the mean rotation of their neighbours across edges, ring by ring; a connected
+//! component without any unfolded face keeps \p theta.
+std::vector<double> solution_frame_angles(const TriMesh& mesh, const GeometryCache& geometry,
+                                          const std::vector<double>& theta,
+                                          const std::vector<int>& corner_wedge,
+                                          const Eigen::VectorXd& x);
 
 //! Solves the QP above starting from the unconstrained minimizer \p y0 (A·y0 = b).
 //! \p factorized_A, when given, holds a factorization of A (enables the dense dual solver).
