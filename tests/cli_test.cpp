@@ -426,7 +426,8 @@ TEST(Cli, OrientationRemovesFoldoversWithoutNodeOptimization) {
 // Where the orientation constraints are infeasible (mask_confmap.obj with a star of dangling
 // arcs to its free eye holes and the field wrapping around them, --wrap-free-holes, as in
 // orientation_test), the report lists the faces they violate most and a warning names the
-// layout node next to them.
+// layout node next to them. Only with the field frame's sectors (--orientation-sectors field):
+// the default goes on to the solution frame's, which unfold this case (session 26).
 TEST(Cli, InfeasibleOrientationNamesTheNodesWhereTheLayoutFolds) {
   const std::string dir = test::shared_meshes_dir();
   if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
@@ -440,7 +441,7 @@ TEST(Cli, InfeasibleOrientationNamesTheNodesWhereTheLayoutFolds) {
   save_layout(layout, layout_file, &mesh);
   std::string out;
   ASSERT_EQ(test::run_command(cli("optimize --no-node-opt --orientation --no-align "
-                                  "--wrap-free-holes --mesh " +
+                                  "--wrap-free-holes --orientation-sectors field --mesh " +
                                   mesh_file + " --layout " + layout_file + " --out " + out_dir),
                               &out),
             0)
@@ -466,6 +467,35 @@ TEST(Cli, InfeasibleOrientationNamesTheNodesWhereTheLayoutFolds) {
                                std::to_string(center.vertex) + ")";
   EXPECT_NE(out.find(expected), std::string::npos) << out;
   EXPECT_NE(out.find("most violated at face"), std::string::npos) << out;
+  EXPECT_EQ(orientation["sector_frame"].get<std::string>(), "field");
+
+  // The default (auto): the field frame's sectors fail as above, the solution frame's unfold
+  // every face, and that result is kept and named.
+  const std::string auto_dir = test::temp_dir("cli_orientation_sectors_auto");
+  ASSERT_EQ(test::run_command(cli("optimize --no-node-opt --orientation --no-align "
+                                  "--wrap-free-holes --mesh " +
+                                  mesh_file + " --layout " + layout_file + " --out " + auto_dir),
+                              &out),
+            0)
+      << out;
+  const auto auto_report = read_json(auto_dir + "/report.json");
+  const auto& auto_orientation = auto_report["fold_removal"]["orientation"];
+  std::printf("[stat] mask star, wrapping holes, auto sectors: %d -> %d fold-overs, %s\n",
+              auto_report["fold_removal"]["foldovers_before"].get<int>(),
+              auto_report["metrics"]["foldovers"].get<int>(),
+              auto_orientation["message"].get<std::string>().c_str());
+  EXPECT_TRUE(auto_orientation["success"].get<bool>());
+  EXPECT_EQ(auto_orientation["sector_frame"].get<std::string>(), "solution");
+  EXPECT_LT(auto_report["metrics"]["foldovers"].get<int>(), left);
+  EXPECT_NE(auto_orientation["message"].get<std::string>().find("field-frame sectors: "),
+            std::string::npos);
+  EXPECT_EQ(test::run_command(cli("optimize --no-node-opt --orientation --orientation-sectors "
+                                  "sideways --mesh " +
+                                  mesh_file + " --layout " + layout_file + " --out " + auto_dir),
+                              &out),
+            1)
+      << "a usage error, like every malformed option: " << out;
+  EXPECT_NE(out.find("--orientation-sectors"), std::string::npos) << out;
 }
 
 // Sliding along the boundary from the command line: a boundary node of a flat grid layout two

@@ -32,7 +32,7 @@ TEST(OrientationDisplaced, SolutionFrameSectorsUnfoldDisplacedSpot) {
   const Layout displaced = perturb_layout(imp.mesh, imp.layout, po).layout;
 
   NodeOptResult r[2];
-  const SectorFrame frames[2] = {SectorFrame::kField, SectorFrame::kSolution};
+  const SectorFrame frames[2] = {SectorFrame::kField, OrientationOptions{}.sector_frame};
   for (int i = 0; i < 2; ++i) {
     PipelineOptions options;
     ASSERT_FALSE(options.param.sizing.enabled);
@@ -40,9 +40,9 @@ TEST(OrientationDisplaced, SolutionFrameSectorsUnfoldDisplacedSpot) {
     no.orientation.sector_frame = frames[i];
     r[i] = optimize_nodes(imp.mesh, displaced, options, no);
     std::printf(
-        "[stat] displaced spot, %s-frame sectors: fold-overs %d -> %d -> %d (%s, %d faces, "
+        "[stat] displaced spot, %s sectors: fold-overs %d -> %d -> %d (%s, %d faces, "
         "%d rounds, %.3f s) E %.6g -> %.6g -> %.6g %s\n",
-        i == 0 ? "field" : "solution", r[i].foldovers_init, r[i].foldovers_descent,
+        i == 0 ? "field" : "default", r[i].foldovers_init, r[i].foldovers_descent,
         r[i].foldovers_final, r[i].orientation_constraints ? "orientation" : "stiffening",
         r[i].orientation.constrained_faces, r[i].orientation.rounds, r[i].orientation.time_s,
         r[i].E_init, r[i].E_descent, r[i].E_final, r[i].orientation.message.c_str());
@@ -50,6 +50,9 @@ TEST(OrientationDisplaced, SolutionFrameSectorsUnfoldDisplacedSpot) {
   const NodeOptResult& field = r[0];
   const NodeOptResult& solution = r[1];
   ASSERT_GT(solution.foldovers_descent, 0) << "the case should fold before the constraints";
+  EXPECT_EQ(solution.orientation.sector_frame, SectorFrame::kSolution)
+      << "the field frame alone should leave fold-overs here (the case's point): "
+      << solution.orientation.message;
   EXPECT_TRUE(solution.orientation_constraints) << solution.orientation.message;
   EXPECT_EQ(solution.foldovers_final, 0) << solution.orientation.message;
   EXPECT_LE(solution.foldovers_final, field.foldovers_final);

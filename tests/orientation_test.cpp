@@ -127,8 +127,9 @@ TEST(OrientationQp, NoFoldsReturnsTheUnconstrainedSolution) {
 
 // solution_frame_angles on a flat fan of six triangles, each with its own three wedges, whose
 // field runs along the global x axis (θ_f in each face's own 2D frame) and whose map is the
-// global (x, y) turned by φ and scaled by 2: every face's rotation from the field to the map is
-// φ, so its Q_k at the returned angle are parallel to its corner offsets. One face mirrored
+// global (x, y) turned by φ (40°) and scaled by 2: every face's rotation from the field to the
+// map is φ, so its Q_k at the returned angle are parallel to its corner offsets; a turn of more
+// than 45° is clamped to 45°. One face mirrored
 // (folded) takes its neighbours' rotation φ; with every face folded, the field frame stays.
 TEST(OrientationQp, SolutionFrameTurnsTheSectorsWithTheMap) {
   TriMesh mesh;
@@ -179,6 +180,18 @@ TEST(OrientationQp, SolutionFrameTurnsTheSectorsWithTheMap) {
     const Eigen::Vector2d d =
         x.segment<2>(0) - (x.segment<2>(0) + x.segment<2>(2) + x.segment<2>(4)) / 3;
     EXPECT_NEAR(std::atan2(d.y(), d.x()) - std::atan2(field[0][0][1], field[0][0][0]), phi, 1e-12);
+  }
+  // A turn beyond 45° is clamped to 45° (the field's winding around the vertices is kept).
+  {
+    Eigen::VectorXd steep(x.size());
+    const double psi = 1.2 - phi;  // turns the map by 1.2 rad from the field in all
+    for (int c = 0; c < 3 * nf; ++c) {
+      const double u = x(2 * c), v = x(2 * c + 1);
+      steep(2 * c) = std::cos(psi) * u - std::sin(psi) * v;
+      steep(2 * c + 1) = std::sin(psi) * u + std::cos(psi) * v;
+    }
+    const std::vector<double> t = solution_frame_angles(mesh, g, theta, corner_wedge, steep);
+    for (int f = 0; f < nf; ++f) EXPECT_NEAR(turn(t[f] - theta[f] + M_PI / 4), 0.0, 1e-12) << f;
   }
   // Face 2 mirrored across its first corner's u: folded; it takes φ from faces 1 and 3.
   Eigen::VectorXd folded = x;

@@ -116,6 +116,13 @@ int main(int argc, char** argv) {
                     "With --no-node-opt: when the parameterization has fold-overs, solve it "
                     "again with strict orientation constraints (the fixed nodes' fold-over "
                     "removal; the node optimization does this by default)");
+  cmd_opt
+      ->add_option("--orientation-sectors", opt.orientation_sectors,
+                   "Frame of the orientation constraints' tri-sectors: auto (the field's; "
+                   "where fold-overs remain, also turned by the solution's rotation, at most "
+                   "45 deg, keeping the result with fewer fold-overs), field or solution")
+      ->check(CLI::IsMember({"auto", "field", "solution"}))
+      ->capture_default_str();
   cmd_opt->add_flag("--no-orientation", opt.no_orientation,
                     "No orientation constraints against fold-overs after the node optimization "
                     "(stiffening only)");

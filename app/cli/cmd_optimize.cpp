@@ -99,6 +99,10 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       throw InvalidInputError("--time-limit applies to the node optimization (not --no-node-opt)");
     if (o.orientation && o.no_orientation)
       throw InvalidInputError("--orientation and --no-orientation contradict each other");
+    const SectorFrame sector_frame = o.orientation_sectors == "field" ? SectorFrame::kField
+                                     : o.orientation_sectors == "solution"
+                                         ? SectorFrame::kSolution
+                                         : SectorFrame::kFieldThenSolution;
     // Node optimization first (it runs its own field + parameterization solves); the final
     // stages below then run on its result.
     double node_s = 0;
@@ -129,6 +133,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       no.stop = time_limit();
       no.gradient = o.gradient == "exact" ? GradientMethod::Exact : GradientMethod::Estimator;
       no.orientation_at_end = !o.no_orientation;
+      no.orientation.sector_frame = sector_frame;
       no.slide_on_curves = !o.no_sliding;
       no.sharp_edges_as_curves = o.keep_sharp_edges;
       // Integer sizes put nodes exactly on shared iso-lines: fresh trial Pipelines there (see
@@ -158,6 +163,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     // any, solves the orientation-constrained QP (ParamSolver::solve), cancellable by signal.
     if (o.orientation) {
       options.param.orientation.enabled = true;
+      options.param.orientation.sector_frame = sector_frame;
       options.param.orientation.observer = &printer;
     }
     // The sizing retry: when the user left the sizing field to the default (off) and fold-overs

@@ -38,6 +38,9 @@ struct OptimizeOptions {
   //! With no_node_opt: the parameterization with strict orientation constraints when it folds
   //! (ParamOptions::orientation, paper §7.2), as the node optimization's last solve does.
   bool orientation = false;
+  //! Sectors of the orientation constraints: "auto" (field frame, then the solution's where
+  //! fold-overs remain), "field" or "solution" (OrientationOptions::sector_frame).
+  std::string orientation_sectors = "auto";
   bool no_sliding = false;        //!< nodes on curves stay (NodeOptOptions::slide_on_curves off)
   bool keep_sharp_edges = false;  //!< NodeOptOptions::sharp_edges_as_curves
   //! Curl-reducing sizing field (ParamOptions::sizing); unset: the library default.

@@ -19,7 +19,8 @@ namespace qs {
 
 namespace {
 
-constexpr int kNamedFaces = 5;  // faces an infeasible round names (OrientationReport)
+constexpr int kNamedFaces = 5;               // faces an infeasible round names (OrientationReport)
+constexpr double kMaxSectorTurn = M_PI / 4;  // solution-frame sectors: turn from the field frame
 
 using Vec2 = Eigen::Vector2d;
 
@@ -494,8 +495,11 @@ std::vector<double> map_frame_angles(const TriMesh& mesh, const GeometryCache& g
     for (const auto& [f, r] : fill) rot[f] = r, known[f] = 1;
     frontier.swap(next);
   }
+  // At most kMaxSectorTurn from the field frame: the frames then keep the field's winding
+  // around every vertex (an unbounded turn let a valence-5 node of fertility's cage layout end
+  // with a 90° cone instead of 450°, every face oriented).
   for (int f = 0; f < nf; ++f)
-    if (known[f]) out[f] = theta[f] + std::arg(rot[f]);
+    if (known[f]) out[f] = theta[f] + std::clamp(std::arg(rot[f]), -kMaxSectorTurn, kMaxSectorTurn);
   return out;
 }
 
@@ -723,59 +727,47 @@ Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& g,
     return solve_in_frame(mesh, g, sector_theta, corner_wedge, red, A, b, y0, o, folded, nbr, r,
                           factorized_A, ordering);
   };
-  if (o.sector_frame == SectorFrame::kField) return attempt(SectorFrame::kField, rep);
+  if (o.sector_frame != SectorFrame::kFieldThenSolution) return attempt(o.sector_frame, rep);
 
-  // Solution-frame sectors first; where fold-overs remain (or the QP is infeasible), the
-  // field frame's sectors too, and the attempt with fewer fold-overs is kept (ties: the first).
-  OrientationReport first;
-  Eigen::VectorXd y_first;
-  std::string first_error;
+  // Field-frame sectors first; where fold-overs remain (or the QP is infeasible), the
+  // solution frame's too, and the attempt with fewer fold-overs is kept (ties: the first).
+  auto name = [](SectorFrame f) {
+    return std::string(f == SectorFrame::kField ? "field" : "solution") + "-frame sectors";
+  };
+  auto account = [&](const OrientationReport& r) {
+    return name(r.sector_frame) + ": " +
+           (r.message.empty() ? std::to_string(r.foldovers_after) + " fold-over(s) remain"
+                              : r.message);
+  };
+  OrientationReport first, second;
+  Eigen::VectorXd y_first, y_second;
+  bool first_failed = false;
   try {
-    y_first = attempt(SectorFrame::kSolution, first);
+    y_first = attempt(SectorFrame::kField, first);
     if (first.foldovers_after == 0) {
       rep = first;
       return y_first;
     }
   } catch (const SolverError& e) {
-    first_error = e.what();
-    if (first.message.empty()) first.message = first_error;
+    first_failed = true;
+    if (first.message.empty()) first.message = e.what();
   }
-  const std::string first_account =
-      "solution-frame sectors: " +
-      (first.message.empty() ? std::to_string(first.foldovers_after) + " fold-over(s) remain"
-                             : first.message);
-  OrientationReport second;
-  Eigen::VectorXd y_second;
+  bool second_failed = false;
   try {
-    y_second = attempt(SectorFrame::kField, second);
+    y_second = attempt(SectorFrame::kSolution, second);
   } catch (const SolverError& e) {
+    second_failed = true;
     if (second.message.empty()) second.message = e.what();
-    if (!first_error.empty()) {  // neither frame gave a solution
-      rep = second;
-      add_effort(rep, first);
-      rep.message = "field-frame sectors: " + second.message + "; " + first_account;
-      throw SolverError(rep.message);
-    }
-    rep = first;
-    add_effort(rep, second);
-    rep.message =
-        (rep.message.empty() ? std::to_string(rep.foldovers_after) + " fold-over(s) remain"
-                             : rep.message) +
-        "; field-frame sectors: " + second.message;
-    return y_first;
   }
-  if (first_error.empty() && first.foldovers_after <= second.foldovers_after) {
-    rep = first;
-    add_effort(rep, second);
-    if (!second.message.empty()) rep.message += "; field-frame sectors: " + second.message;
-    return y_first;
-  }
-  rep = second;
-  add_effort(rep, first);
-  rep.message = (rep.message.empty() ? std::string("field-frame sectors used")
-                                     : "field-frame sectors: " + rep.message) +
-                " (" + first_account + ")";
-  return y_second;
+  const bool keep_first =
+      second_failed || (!first_failed && first.foldovers_after <= second.foldovers_after);
+  const OrientationReport& kept = keep_first ? first : second;
+  const OrientationReport& other = keep_first ? second : first;
+  rep = kept;
+  add_effort(rep, other);
+  rep.message = account(kept) + "; " + account(other);
+  if (first_failed && second_failed) throw SolverError(rep.message);
+  return keep_first ? y_first : y_second;
 }
 
 }  // namespace qs

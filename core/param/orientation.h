@@ -42,18 +42,19 @@
 //
 // Sector frame (OrientationOptions::sector_frame). The rays need not come from the field frame:
 // any three sectors in ccw order, each narrower than π, make the condition above sufficient.
-// By default each face's Q_k are rotated by the rotation closest to the unconstrained solution's
-// Jacobian on that face (its polar factor; folded and degenerate faces take the mean rotation of
-// their neighbours, ring by ring), so the sectors sit where the solution already puts the
-// corners. Where the layout makes the map turn away from the field (the arcs leave the field's
-// directions near crowded nodes), field-frame sectors ask each face to turn back, which together
-// with the iso-line constraints can be infeasible: spot's displaced imported layout
-// (perturb --rings 2 --seed 1) ends with 4 fold-overs with field-frame sectors and 0 with these.
-// Neither frame contains the other's feasible set, so where fold-overs remain with the solution
-// frame (or its QP is infeasible), the field frame's QP is solved as well and the solution with
-// fewer fold-overs kept (inspired_mesh's coarsened layout with split constraint clusters: 2
-// fold-overs left with the solution frame, 0 with the field frame); the report's counts and time
-// then cover both attempts.
+// The solution frame turns each face's Q_k by the rotation closest to the unconstrained
+// solution's Jacobian on that face (its polar factor; folded and degenerate faces take the mean
+// rotation of their neighbours, ring by ring), by at most 45° from the field frame, so the
+// sectors sit nearer to where the solution puts the corners while keeping the field's winding
+// around every vertex. Where the layout makes the map turn away from the field (arcs that leave
+// the field's directions near crowded nodes), field-frame sectors ask each face to turn back,
+// which together with the iso-line constraints can be infeasible: spot's displaced imported
+// layout (perturb --rings 2 --seed 1, no sizing) ends with 4 fold-overs with field-frame sectors
+// and 0 with solution-frame ones. Neither frame's feasible set contains the other's (inspired_
+// mesh's coarsened layout with split constraint clusters: infeasible in the solution frame, 0
+// fold-overs in the field frame), so by default the field frame is solved first and, only where
+// fold-overs remain, the solution frame as well; the solution with fewer fold-overs is kept and
+// the report's counts and time cover both attempts.
 //
 // Active set. Only faces that need it are constrained: the folded faces of the unconstrained
 // solution and `rings` rings of neighbours around them; when the constrained solution folds
@@ -77,13 +78,14 @@ namespace qs {
 enum class SectorFrame {
   kField,     //!< the field frame (u_t, v_t) of each face (algorithm.md §7.2 as written)
   kSolution,  //!< the field frame turned by the unconstrained solution's rotation on the face
+  kFieldThenSolution,  //!< kField; where fold-overs remain, kSolution too; fewer fold-overs kept
 };
 
 struct OrientationOptions {
   //! Apply the constraints in the parameterization solve when it has fold-overs
   //! (ParamOptions::orientation; the node optimizer enables it for its last solve).
   bool enabled = false;
-  SectorFrame sector_frame = SectorFrame::kSolution;  //!< the frame of the tri-sector rays
+  SectorFrame sector_frame = SectorFrame::kFieldThenSolution;  //!< frame of the tri-sector rays
   int rings = 2;            //!< neighbour rings (across edges) added around each folded face
   int max_rounds = 5;       //!< active-set growth rounds (QP solves) at most
   int max_iterations = 60;  //!< interior-point iterations per QP at most (one factorization each)
@@ -135,7 +137,7 @@ struct OrientationReport {
   bool dense = false;                          //!< the last round used the dense dual solver
   double energy_before = 0, energy_after = 0;  //!< value of the (weighted) energy (1)
   double time_s = 0;
-  //! The frame of the sectors of the returned solution (kSolution: field frame not needed).
+  //! The frame of the sectors of the returned solution (kField or kSolution).
   SectorFrame sector_frame = SectorFrame::kField;
   std::string message;  //!< why it failed, if it did
   //! When the last round was infeasible: the constrained faces its last iterate violates most
