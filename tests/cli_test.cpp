@@ -440,12 +440,15 @@ TEST(Cli, InfeasibleOrientationNamesTheNodesWhereTheLayoutFolds) {
   const std::string layout_file = out_dir + "/star.layout.json";
   save_layout(layout, layout_file, &mesh);
   std::string out;
-  ASSERT_EQ(test::run_command(cli("optimize --no-node-opt --orientation --no-align "
-                                  "--wrap-free-holes --orientation-sectors field --mesh " +
-                                  mesh_file + " --layout " + layout_file + " --out " + out_dir),
-                              &out),
-            0)
-      << out;
+  // The fixed star with orientation constraints on the wrapping field; \p sectors: extra option.
+  auto run_star = [&](const std::string& sectors, const std::string& dir) {
+    return test::run_command(
+        cli("optimize --no-node-opt --orientation --no-align "
+            "--wrap-free-holes " +
+            sectors + " --mesh " + mesh_file + " --layout " + layout_file + " --out " + dir),
+        &out);
+  };
+  ASSERT_EQ(run_star("--orientation-sectors field", out_dir), 0) << out;
   const auto report = read_json(out_dir + "/report.json");
   const auto& orientation = report["fold_removal"]["orientation"];
   ASSERT_TRUE(orientation["ran"].get<bool>());
@@ -472,12 +475,7 @@ TEST(Cli, InfeasibleOrientationNamesTheNodesWhereTheLayoutFolds) {
   // The default (auto): the field frame's sectors fail as above, the solution frame's unfold
   // every face, and that result is kept and named.
   const std::string auto_dir = test::temp_dir("cli_orientation_sectors_auto");
-  ASSERT_EQ(test::run_command(cli("optimize --no-node-opt --orientation --no-align "
-                                  "--wrap-free-holes --mesh " +
-                                  mesh_file + " --layout " + layout_file + " --out " + auto_dir),
-                              &out),
-            0)
-      << out;
+  ASSERT_EQ(run_star("", auto_dir), 0) << out;
   const auto auto_report = read_json(auto_dir + "/report.json");
   const auto& auto_orientation = auto_report["fold_removal"]["orientation"];
   std::printf("[stat] mask star, wrapping holes, auto sectors: %d -> %d fold-overs, %s\n",
@@ -489,11 +487,7 @@ TEST(Cli, InfeasibleOrientationNamesTheNodesWhereTheLayoutFolds) {
   EXPECT_LT(auto_report["metrics"]["foldovers"].get<int>(), left);
   EXPECT_NE(auto_orientation["message"].get<std::string>().find("field-frame sectors: "),
             std::string::npos);
-  EXPECT_EQ(test::run_command(cli("optimize --no-node-opt --orientation --orientation-sectors "
-                                  "sideways --mesh " +
-                                  mesh_file + " --layout " + layout_file + " --out " + auto_dir),
-                              &out),
-            1)
+  EXPECT_EQ(run_star("--orientation-sectors sideways", auto_dir), 1)
       << "a usage error, like every malformed option: " << out;
   EXPECT_NE(out.find("--orientation-sectors"), std::string::npos) << out;
 }
