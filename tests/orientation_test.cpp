@@ -161,7 +161,7 @@ TEST(OrientationQp, SolutionFrameTurnsTheSectorsWithTheMap) {
   }
   auto turn = [](double a) { return std::remainder(a, 2 * M_PI); };
   {
-    const std::vector<double> t = solution_frame_angles(mesh, g, theta, corner_wedge, x);
+    const std::vector<double> t = solution_frame_angles(g, theta, corner_wedge, x);
     ASSERT_EQ(static_cast<int>(t.size()), nf);
     const auto ideal = ideal_corner_offsets(mesh, g, t);
     for (int f = 0; f < nf; ++f) {
@@ -190,21 +190,21 @@ TEST(OrientationQp, SolutionFrameTurnsTheSectorsWithTheMap) {
       steep(2 * c) = std::cos(psi) * u - std::sin(psi) * v;
       steep(2 * c + 1) = std::sin(psi) * u + std::cos(psi) * v;
     }
-    const std::vector<double> t = solution_frame_angles(mesh, g, theta, corner_wedge, steep);
+    const std::vector<double> t = solution_frame_angles(g, theta, corner_wedge, steep);
     for (int f = 0; f < nf; ++f) EXPECT_NEAR(turn(t[f] - theta[f] + M_PI / 4), 0.0, 1e-12) << f;
   }
   // Face 2 mirrored across its first corner's u: folded; it takes φ from faces 1 and 3.
   Eigen::VectorXd folded = x;
   for (int k = 0; k < 3; ++k) folded(2 * (6 + k)) = 2 * x(2 * 6) - x(2 * (6 + k));
   ASSERT_EQ(count_foldovers(corner_wedge, folded), 1);
-  const std::vector<double> t = solution_frame_angles(mesh, g, theta, corner_wedge, folded);
+  const std::vector<double> t = solution_frame_angles(g, theta, corner_wedge, folded);
   for (int f = 0; f < nf; ++f) EXPECT_NEAR(turn(t[f] - theta[f] + phi), 0.0, 1e-12) << f;
   // Every face folded: nothing to take a rotation from.
   Eigen::VectorXd all = x;
   for (int c = 0; c < 3 * nf; ++c) all(2 * c) = -x(2 * c);
   ASSERT_EQ(count_foldovers(corner_wedge, all), nf);
-  EXPECT_EQ(solution_frame_angles(mesh, g, theta, corner_wedge, all), theta);
-  EXPECT_THROW(solution_frame_angles(mesh, g, theta, corner_wedge, x.head(4)), InvalidInputError);
+  EXPECT_EQ(solution_frame_angles(g, theta, corner_wedge, all), theta);
+  EXPECT_THROW(solution_frame_angles(g, theta, corner_wedge, x.head(4)), InvalidInputError);
 }
 
 // ---------------------------------------------------------------------------------------------

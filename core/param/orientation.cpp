@@ -451,8 +451,7 @@ IpmOutcome interior_point_dual(const Eigen::MatrixXd& S, const Eigen::VectorXd& 
 }
 
 // solution_frame_angles (header) with the face adjacency at hand.
-std::vector<double> map_frame_angles(const TriMesh& mesh, const GeometryCache& g,
-                                     const std::vector<double>& theta,
+std::vector<double> map_frame_angles(const GeometryCache& g, const std::vector<double>& theta,
                                      const std::vector<int>& corner_wedge, const Eigen::VectorXd& x,
                                      const std::vector<std::vector<int>>& nbr) {
   const int nf = g.n_faces;
@@ -461,15 +460,15 @@ std::vector<double> map_frame_angles(const TriMesh& mesh, const GeometryCache& g
   std::vector<std::complex<double>> rot(nf, 0.0);
   std::vector<char> known(nf, 0);
   for (int f = 0; f < nf; ++f) {
-    const auto p = face_corners_2d(mesh, g, f);
-    Eigen::Matrix2d E, P;
-    for (int k = 1; k < 3; ++k) {
-      E.col(k - 1) = Vec2(p[k][0] - p[0][0], p[k][1] - p[0][1]);
-      const int w = corner_wedge[3 * f + k], w0 = corner_wedge[3 * f];
-      P.col(k - 1) = Vec2(x(2 * w) - x(2 * w0), x(2 * w + 1) - x(2 * w0 + 1));
+    // Jacobian of the map in the face frame: J = Σ_k x(corner k) ⊗ ∇φ_k (cached gradients).
+    const auto& grad = g.face_gradient[f];
+    if (!(grad[6] > 0)) continue;  // degenerate 3D triangle
+    Eigen::Matrix2d J = Eigen::Matrix2d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      const int w = corner_wedge[3 * f + k];
+      J += Vec2(x(2 * w), x(2 * w + 1)) * Eigen::RowVector2d(grad[2 * k], grad[2 * k + 1]);
     }
-    if (!(E.determinant() > 0) || !(P.determinant() > 0)) continue;
-    const Eigen::Matrix2d J = P * E.inverse();
+    if (!(J.determinant() > 0)) continue;  // folded or collapsed by the map
     // Closest rotation R(ψ) to J; the frame (cos θ', sin θ') maps q to R(−θ')q, so θ' = −ψ.
     const double psi = std::atan2(J(1, 0) - J(0, 1), J(0, 0) + J(1, 1));
     rot[f] = std::polar(1.0, -psi - theta[f]);
@@ -523,17 +522,17 @@ std::vector<std::array<std::array<double, 2>, 3>> ideal_corner_offsets(
   return out;
 }
 
-std::vector<double> solution_frame_angles(const TriMesh& mesh, const GeometryCache& g,
-                                          const std::vector<double>& theta,
+std::vector<double> solution_frame_angles(const GeometryCache& g, const std::vector<double>& theta,
                                           const std::vector<int>& corner_wedge,
                                           const Eigen::VectorXd& x) {
   if (static_cast<int>(theta.size()) != g.n_faces ||
-      static_cast<int>(corner_wedge.size()) != 3 * g.n_faces)
+      static_cast<int>(corner_wedge.size()) != 3 * g.n_faces ||
+      static_cast<int>(g.face_gradient.size()) != g.n_faces)
     throw InvalidInputError("solution_frame_angles: inconsistent sizes");
   for (int w : corner_wedge)
     if (w < 0 || 2 * static_cast<Eigen::Index>(w) + 1 >= x.size())
       throw InvalidInputError("solution_frame_angles: corner wedge out of range");
-  return map_frame_angles(mesh, g, theta, corner_wedge, x, face_neighbours(g));
+  return map_frame_angles(g, theta, corner_wedge, x, face_neighbours(g));
 }
 
 int count_foldovers(const std::vector<int>& corner_wedge, const Eigen::VectorXd& x,
@@ -708,6 +707,10 @@ Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& g,
     throw InvalidInputError("orientation constraints: inconsistent problem sizes");
   if (!(o.margin > 0) || o.rings < 0 || o.max_rounds < 1 || o.max_iterations < 1)
     throw InvalidInputError("orientation constraints: invalid options");
+  if (o.sector_frame != SectorFrame::kField &&
+      static_cast<int>(g.face_gradient.size()) != g.n_faces)
+    throw InvalidInputError(
+        "orientation constraints: solution-frame sectors need the geometry's face gradients");
 
   std::vector<char> folded;
   const Eigen::VectorXd x0 = red.Z * y0 + red.z0;
@@ -722,8 +725,7 @@ Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& g,
     r.foldovers_before = foldovers_before;
     r.sector_frame = frame;
     const std::vector<double> sector_theta =
-        frame == SectorFrame::kSolution ? map_frame_angles(mesh, g, theta, corner_wedge, x0, nbr)
-                                        : theta;
+        frame == SectorFrame::kSolution ? map_frame_angles(g, theta, corner_wedge, x0, nbr) : theta;
     return solve_in_frame(mesh, g, sector_theta, corner_wedge, red, A, b, y0, o, folded, nbr, r,
                           factorized_A, ordering);
   };
@@ -739,26 +741,24 @@ Eigen::VectorXd solve_oriented(const TriMesh& mesh, const GeometryCache& g,
            (r.message.empty() ? std::to_string(r.foldovers_after) + " fold-over(s) remain"
                               : r.message);
   };
+  // An attempt whose QP gives no solution (SolverError) is recorded as failed, with its message.
+  auto guarded = [&](SectorFrame frame, OrientationReport& r, Eigen::VectorXd& y) {
+    try {
+      y = attempt(frame, r);
+      return true;
+    } catch (const SolverError& e) {
+      if (r.message.empty()) r.message = e.what();
+      return false;
+    }
+  };
   OrientationReport first, second;
   Eigen::VectorXd y_first, y_second;
-  bool first_failed = false;
-  try {
-    y_first = attempt(SectorFrame::kField, first);
-    if (first.foldovers_after == 0) {
-      rep = first;
-      return y_first;
-    }
-  } catch (const SolverError& e) {
-    first_failed = true;
-    if (first.message.empty()) first.message = e.what();
+  const bool first_failed = !guarded(SectorFrame::kField, first, y_first);
+  if (!first_failed && first.foldovers_after == 0) {
+    rep = first;
+    return y_first;
   }
-  bool second_failed = false;
-  try {
-    y_second = attempt(SectorFrame::kSolution, second);
-  } catch (const SolverError& e) {
-    second_failed = true;
-    if (second.message.empty()) second.message = e.what();
-  }
+  const bool second_failed = !guarded(SectorFrame::kSolution, second, y_second);
   const bool keep_first =
       second_failed || (!first_failed && first.foldovers_after <= second.foldovers_after);
   const OrientationReport& kept = keep_first ? first : second;

@@ -155,8 +155,9 @@ std::vector<std::array<std::array<double, 2>, 3>> ideal_corner_offsets(
 //! wedge; \p corner_wedge: size 3·#F): for a map that is a rotation times a scale on a face,
 //! the face's Q_k are then parallel to its corner offsets. Faces the map folds or collapses
 //! take the mean rotation of their neighbours across edges, ring by ring; a connected
-//! component without any unfolded face keeps \p theta.
-std::vector<double> solution_frame_angles(const TriMesh& mesh, const GeometryCache& geometry,
+//! component without any unfolded face keeps \p theta. Uses the geometry's cached hat-function
+//! gradients (\ref GeometryCache::face_gradient; refused without them).
+std::vector<double> solution_frame_angles(const GeometryCache& geometry,
                                           const std::vector<double>& theta,
                                           const std::vector<int>& corner_wedge,
                                           const Eigen::VectorXd& x);
