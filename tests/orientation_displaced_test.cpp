@@ -9,6 +9,7 @@
 
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "core/layout/perturb.h"
 #include "core/layout/quad_import.h"
@@ -59,6 +60,56 @@ TEST(OrientationDisplaced, SolutionFrameSectorsUnfoldDisplacedSpot) {
   // The constrained solve stays close to the descent's energy (it only unfolds).
   EXPECT_LE(solution.E_final, 1.25 * solution.E_descent);
   EXPECT_LT(solution.E_final, solution.E_init);
+}
+
+// Node pairs on a common mesh edge (two nodes on one triangle) of which at least one node is
+// not on its vertex of \p before: pairs that the optimization made.
+int new_node_pairs_on_an_edge(const TriMesh& mesh, const Layout& before, const Layout& after) {
+  std::vector<int> node_at(mesh.n_vertices(), -1);
+  for (size_t n = 0; n < after.nodes.size(); ++n) node_at[after.nodes[n].vertex] = n;
+  int pairs = 0;
+  for (auto e : mesh.edges()) {
+    const auto h = mesh.halfedge_handle(e, 0);
+    const int a = node_at[mesh.from_vertex_handle(h).idx()];
+    const int b = node_at[mesh.to_vertex_handle(h).idx()];
+    if (a < 0 || b < 0) continue;
+    pairs += after.nodes[a].vertex != before.nodes[a].vertex ||
+             after.nodes[b].vertex != before.nodes[b].vertex;
+  }
+  return pairs;
+}
+
+// NodeOptOptions::keep_nodes_apart: on the displaced spot (about 3 edges per patch side) the
+// default descent and hop polish carry nodes next to other nodes; with the option no node that
+// moved to another vertex ends on another node's 1-ring (nodes displaced next to each other
+// may stay), and the descent still lowers E.
+TEST(OrientationDisplaced, KeepNodesApartLeavesNoNewNodesOnATriangle) {
+  const std::string dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
+  const QuadImportResult imp =
+      import_quads(load_poly_mesh(dir + "/spot/spot_quadrangulated.obj"), nullptr, {});
+  PerturbLayoutOptions po;
+  po.rings = 2;
+  po.seed = 1;
+  const Layout displaced = perturb_layout(imp.mesh, imp.layout, po).layout;
+  int pairs[2];
+  NodeOptResult r[2];
+  for (int apart = 0; apart < 2; ++apart) {
+    NodeOptOptions no;
+    no.keep_nodes_apart = apart == 1;
+    no.orientation_at_end = false;  // the descent and the hop polish only
+    no.stiffen_at_end = false;
+    r[apart] = optimize_nodes(imp.mesh, displaced, PipelineOptions{}, no);
+    pairs[apart] = new_node_pairs_on_an_edge(imp.mesh, displaced, r[apart].layout);
+    std::printf(
+        "[stat] displaced spot, keep_nodes_apart %d: new node pairs on an edge %d, "
+        "E %.6g -> %.6g, fold-overs %d -> %d, %d steps, %d hops\n",
+        apart, pairs[apart], r[apart].E_init, r[apart].E_descent, r[apart].foldovers_init,
+        r[apart].foldovers_descent, r[apart].steps, r[apart].hops);
+  }
+  EXPECT_GT(pairs[0], 0) << "without the option nodes should move next to others (the premise)";
+  EXPECT_EQ(pairs[1], 0);
+  EXPECT_LT(r[1].E_descent, r[1].E_init);
 }
 
 }  // namespace

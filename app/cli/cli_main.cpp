@@ -112,6 +112,10 @@ int main(int argc, char** argv) {
                     "Treat the sharp edges (--sharp-angle) as feature curves in the node "
                     "optimization: nodes on them slide along them and their vertices keep their "
                     "place (sharp edges keep their shape; higher E)");
+  cmd_opt->add_flag("--keep-nodes-apart", opt.keep_nodes_apart,
+                    "Never carry a moving node onto a vertex next to another node (no two nodes "
+                    "on one triangle): for dense layouts with a few edges per patch side, where "
+                    "nodes crowding together make the fold-over removal fail");
   cmd_opt->add_flag("--orientation", opt.orientation,
                     "With --no-node-opt: when the parameterization has fold-overs, solve it "
                     "again with strict orientation constraints (the fixed nodes' fold-over "

@@ -136,6 +136,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       no.orientation.sector_frame = sector_frame;
       no.slide_on_curves = !o.no_sliding;
       no.sharp_edges_as_curves = o.keep_sharp_edges;
+      no.keep_nodes_apart = o.keep_nodes_apart;
       // Integer sizes put nodes exactly on shared iso-lines: fresh trial Pipelines there (see
       // NodeOptOptions::reuse_field).
       if (o.integer) no.reuse_field = false;

@@ -63,6 +63,8 @@ struct HopSweepOptions {
   double min_direction_cos = -1;
   int max_evaluations = 2000;    //!< candidate solves in this sweep (work cap)
   RelocationOptions relocation;  //!< re-routing of the moved node's arcs, orientation check
+  //! No hop onto a vertex next to another node (next_to_other_nodes).
+  bool keep_nodes_apart = false;
   //! Before its neighbours, a node whose vertex is relocated (its position in the mesh differs
   //! from \p original) tries staying on that vertex with the relocation undone (the vertex back
   //! at its original position, layout unchanged): the continuous descent cannot reach a vertex's

@@ -331,7 +331,8 @@ struct NodeOptimizer::Impl {
     // Vertices the walk may not pass or take: other nodes and other arcs; it stops on a free
     // curve end, junction or corner (the node then sits on that vertex, which keeps its place).
     auto occupied = [&](int c) {
-      return c != v && occupied_by_layout(trial.layout, n, obstacles, c);
+      return c != v &&
+             (occupied_by_layout(trial.layout, n, obstacles, c) || next_to_other_node(v, c));
     };
     // Walk: the point ends on segment (seq[k], seq[k+1]) at fraction s from seq[k].
     size_t k = 0;
@@ -384,6 +385,7 @@ struct NodeOptimizer::Impl {
       if (!relocation_keeps_orientation(trial.mesh, original, w == v ? -1 : v, w, at,
                                         no.relocation))
         continue;
+      if (w != v && next_to_other_node(v, w)) continue;
       if (w != v) {
         const size_t iw = std::find(seq.begin(), seq.end(), w) - seq.begin();
         std::vector<int> path;  // the curve vertices from v to w
@@ -398,6 +400,7 @@ struct NodeOptimizer::Impl {
         trial.mesh.set_point(trial.mesh.vertex_handle(v), point(v));
         switched[i] = 1;
         target[i] = w;
+        move_near_count(v, w);
       }
       trial.mesh.set_point(trial.mesh.vertex_handle(w), at);
       const int other = w == seq[k] ? seq[k + 1] : seq[k];
@@ -406,6 +409,38 @@ struct NodeOptimizer::Impl {
       return true;
     }
     return false;
+  }
+
+  // Per vertex: the nodes of the trial layout whose vertex or 1-ring (original connectivity)
+  // it is (keep_nodes_apart); empty when off.
+  std::vector<int> near_count;
+  void count_nodes_near(const Layout& layout) {
+    near_count.clear();
+    if (!no.keep_nodes_apart) return;
+    near_count.assign(original.n_vertices(), 0);
+    for (const auto& node : layout.nodes) move_near_count(-1, node.vertex);
+  }
+  // A node moved from vertex \p from (−1: none) to \p to (−1: none).
+  void move_near_count(int from, int to) {
+    if (near_count.empty()) return;
+    for (int v : {from, to}) {
+      if (v < 0) continue;
+      const int d = v == from ? -1 : 1;
+      for (int w : ring_of(v)) near_count[w] += d;
+    }
+  }
+  // Vertex \p v and its 1-ring (original connectivity).
+  std::vector<int> ring_of(int v) const {
+    std::vector<int> out{v};
+    for (auto wh : original.vv_range(original.vertex_handle(v))) out.push_back(wh.idx());
+    return out;
+  }
+  // Vertex \p u is next to a node other than the one at vertex \p own (keep_nodes_apart).
+  bool next_to_other_node(int own, int u) const {
+    if (near_count.empty()) return false;
+    const std::vector<int> mine = ring_of(own);
+    const int in_mine = std::find(mine.begin(), mine.end(), u) != mine.end();
+    return near_count[u] - in_mine > 0;
   }
 
   // The Pipeline of a state whose nodes moved to other vertices (re-routed layout): continued
@@ -502,6 +537,7 @@ struct NodeOptimizer::Impl {
     auto run_sweep = [&](const std::vector<int>& nodes, const std::vector<Vec3>& directions,
                          HopSweepOptions sweep, bool counts_evaluations) {
       sweep.relocation = no.relocation;
+      sweep.keep_nodes_apart = no.keep_nodes_apart;
       sweep.stop = no.stop;
       if (nodes.empty() || sweep.max_evaluations <= 0) return;
       const HopSweepResult s =
@@ -562,8 +598,11 @@ struct NodeOptimizer::Impl {
       for (size_t i = 0; i < cones.hop_nodes.size(); ++i) {
         const int n = cones.hop_nodes[i];
         const std::vector<char> forbidden = forbidden_relocation_vertices(original, all.layout, n);
+        const std::vector<char> near = no.keep_nodes_apart
+                                           ? next_to_other_nodes(original, all.layout, n)
+                                           : std::vector<char>(forbidden.size(), 0);
         for (int w : cones.hop_targets[i])
-          if (!forbidden[w] &&
+          if (!forbidden[w] && !near[w] &&
               move_node_and_reroute(all.mesh, all.layout, n, w, no.relocation, &reroute)) {
             ++moved;
             break;
@@ -757,6 +796,7 @@ struct NodeOptimizer::Impl {
       // Arc and node obstacles of the trial layout, kept up to date by each re-routing.
       // Vertices on the curves are not relocated for other nodes (paper §6.1.1).
       LayoutObstacles obstacles = make_layout_obstacles(trial.mesh, trial.layout, &curves);
+      count_nodes_near(trial.layout);
       for (size_t i = 0; i < movable.size(); ++i) {
         const int n = movable[i];
         if (on_curve(trial.layout.nodes[n].vertex)) {
@@ -783,7 +823,7 @@ struct NodeOptimizer::Impl {
             const double d = (original.point(vh) - tr.end_position).norm();
             if (d < near_d) near_d = d, near = vh.idx();
           }
-          if (near >= 0 && near != v && on_curve(near) &&
+          if (near >= 0 && near != v && on_curve(near) && !next_to_other_node(v, near) &&
               !original.is_boundary(original.vertex_handle(near)) &&
               !occupied_by_layout(trial.layout, n, obstacles, near) &&
               relocation_keeps_orientation(trial.mesh, original, v, near,
@@ -793,6 +833,7 @@ struct NodeOptimizer::Impl {
                                     &obstacles)) {
             trial.mesh.set_point(trial.mesh.vertex_handle(v),
                                  original.point(original.vertex_handle(v)));
+            move_near_count(v, near);
             trial.anchor[n] = vertex_surface_point(original, near);
             trial.curve[n] = CurvePoint{};
             switched[i] = 1;
@@ -802,7 +843,8 @@ struct NodeOptimizer::Impl {
           }
         }
         const auto forbidden = [&](int u) {
-          return no_switch[i] || relocation_forbidden(trial.layout, n, obstacles, u);
+          return no_switch[i] || relocation_forbidden(trial.layout, n, obstacles, u) ||
+                 (u != v && next_to_other_node(v, u));
         };
         const int w = choose_relocation_vertex(trial.mesh, original, tr.end, tr.end_position, v,
                                                forbidden, no.relocation);
@@ -815,6 +857,7 @@ struct NodeOptimizer::Impl {
                                original.point(original.vertex_handle(v)));
           switched[i] = 1;
           target[i] = w;
+          move_near_count(v, w);
         }
         trial.mesh.set_point(trial.mesh.vertex_handle(w), tr.end_position);
         trial.anchor[n] = tr.end;

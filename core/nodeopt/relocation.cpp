@@ -114,6 +114,17 @@ std::vector<char> forbidden_relocation_vertices(const TriMesh& mesh, const Layou
   return out;
 }
 
+std::vector<char> next_to_other_nodes(const TriMesh& mesh, const Layout& layout, int node_index) {
+  std::vector<char> out(mesh.n_vertices(), 0);
+  for (size_t n = 0; n < layout.nodes.size(); ++n) {
+    if (static_cast<int>(n) == node_index) continue;
+    const auto vh = mesh.vertex_handle(layout.nodes[n].vertex);
+    out[vh.idx()] = 1;
+    for (auto wh : mesh.vv_range(vh)) out[wh.idx()] = 1;
+  }
+  return out;
+}
+
 LayoutObstacles make_layout_obstacles(const TriMesh& mesh, const Layout& layout,
                                       const CurveNetwork* curves) {
   LayoutObstacles out;
