@@ -22,15 +22,24 @@
 namespace qs {
 namespace {
 
-TEST(OrientationDisplaced, SolutionFrameSectorsUnfoldDisplacedSpot) {
-  const std::string dir = test::shared_meshes_dir();
-  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
-  const QuadImportResult imp =
-      import_quads(load_poly_mesh(dir + "/spot/spot_quadrangulated.obj"), nullptr, {});
+// Spot's quad mesh imported onto its own triangulation.
+QuadImportResult import_spot(const std::string& dir) {
+  return import_quads(load_poly_mesh(dir + "/spot/spot_quadrangulated.obj"), nullptr, {});
+}
+
+// Every node displaced two rings (`perturb --rings 2 --seed 1`, as scripts/bench.sh does).
+Layout displace(const QuadImportResult& imp) {
   PerturbLayoutOptions po;
   po.rings = 2;
   po.seed = 1;
-  const Layout displaced = perturb_layout(imp.mesh, imp.layout, po).layout;
+  return perturb_layout(imp.mesh, imp.layout, po).layout;
+}
+
+TEST(OrientationDisplaced, SolutionFrameSectorsUnfoldDisplacedSpot) {
+  const std::string dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
+  const QuadImportResult imp = import_spot(dir);
+  const Layout displaced = displace(imp);
 
   NodeOptResult r[2];
   const SectorFrame frames[2] = {SectorFrame::kField, OrientationOptions{}.sector_frame};
@@ -86,12 +95,8 @@ int new_node_pairs_on_an_edge(const TriMesh& mesh, const Layout& before, const L
 TEST(OrientationDisplaced, KeepNodesApartLeavesNoNewNodesOnATriangle) {
   const std::string dir = test::shared_meshes_dir();
   if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
-  const QuadImportResult imp =
-      import_quads(load_poly_mesh(dir + "/spot/spot_quadrangulated.obj"), nullptr, {});
-  PerturbLayoutOptions po;
-  po.rings = 2;
-  po.seed = 1;
-  const Layout displaced = perturb_layout(imp.mesh, imp.layout, po).layout;
+  const QuadImportResult imp = import_spot(dir);
+  const Layout displaced = displace(imp);
   int pairs[2];
   NodeOptResult r[2];
   for (int apart = 0; apart < 2; ++apart) {
