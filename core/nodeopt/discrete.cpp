@@ -17,11 +17,8 @@ namespace {
 std::vector<int> hop_candidates(const TriMesh& original, const Layout& layout, int n,
                                 const Vec3* direction, const HopSweepOptions& o) {
   const int v = layout.nodes[n].vertex;
-  std::vector<char> forbidden = forbidden_relocation_vertices(original, layout, n);
-  if (o.keep_nodes_apart) {
-    const std::vector<char> near = next_to_other_nodes(original, layout, n);
-    for (size_t w = 0; w < forbidden.size(); ++w) forbidden[w] |= near[w];
-  }
+  const std::vector<char> forbidden =
+      forbidden_relocation_vertices(original, layout, n, o.keep_nodes_apart);
   const auto vh = original.vertex_handle(v);
   std::vector<std::pair<double, int>> ranked;  // (−cos, vertex), or (0, vertex) in ring order
   for (auto wh : original.vv_range(vh)) {
@@ -196,11 +193,13 @@ HopSweepResult hop_sweep(const TriMesh& original, TriMesh& mesh, Layout& layout,
       return std::find(along.begin(), along.end(), w) != along.end();
     };
     if (!o.targets.empty()) {
+      // A step along the curve may take a forbidden (curve) vertex, never one next to a node.
       const std::vector<char> forbidden = forbidden_relocation_vertices(original, layout, n);
-      const std::vector<char> near = o.keep_nodes_apart ? next_to_other_nodes(original, layout, n)
-                                                        : std::vector<char>(forbidden.size(), 0);
+      const std::vector<char> near =
+          o.keep_nodes_apart ? next_to_other_nodes(original, layout, n) : std::vector<char>{};
       for (int w : o.targets[i]) {
-        if (w != v && (!forbidden[w] || on_curve_step(w)) && !near[w]) vertices.push_back(w);
+        if (w != v && (!forbidden[w] || on_curve_step(w)) && (near.empty() || !near[w]))
+          vertices.push_back(w);
       }
     } else if (o.try_neighbours) {
       vertices = hop_candidates(original, layout, n, direction, o);

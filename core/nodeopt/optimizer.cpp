@@ -418,29 +418,26 @@ struct NodeOptimizer::Impl {
     near_count.clear();
     if (!no.keep_nodes_apart) return;
     near_count.assign(original.n_vertices(), 0);
-    for (const auto& node : layout.nodes) move_near_count(-1, node.vertex);
+    for (const auto& node : layout.nodes) add_near_count(node.vertex, 1);
   }
-  // A node moved from vertex \p from (−1: none) to \p to (−1: none).
+  // Adds \p d to the count of vertex \p v and of its 1-ring.
+  void add_near_count(int v, int d) {
+    const auto vh = original.vertex_handle(v);
+    near_count[v] += d;
+    for (auto wh : original.vv_range(vh)) near_count[wh.idx()] += d;
+  }
+  // A node moved from vertex \p from to vertex \p to.
   void move_near_count(int from, int to) {
     if (near_count.empty()) return;
-    for (int v : {from, to}) {
-      if (v < 0) continue;
-      const int d = v == from ? -1 : 1;
-      for (int w : ring_of(v)) near_count[w] += d;
-    }
-  }
-  // Vertex \p v and its 1-ring (original connectivity).
-  std::vector<int> ring_of(int v) const {
-    std::vector<int> out{v};
-    for (auto wh : original.vv_range(original.vertex_handle(v))) out.push_back(wh.idx());
-    return out;
+    add_near_count(from, -1);
+    add_near_count(to, 1);
   }
   // Vertex \p u is next to a node other than the one at vertex \p own (keep_nodes_apart).
   bool next_to_other_node(int own, int u) const {
     if (near_count.empty()) return false;
-    const std::vector<int> mine = ring_of(own);
-    const int in_mine = std::find(mine.begin(), mine.end(), u) != mine.end();
-    return near_count[u] - in_mine > 0;
+    bool mine = u == own;  // the own node's count covers u too
+    for (auto wh : original.vv_range(original.vertex_handle(own))) mine |= wh.idx() == u;
+    return near_count[u] - (mine ? 1 : 0) > 0;
   }
 
   // The Pipeline of a state whose nodes moved to other vertices (re-routed layout): continued
@@ -597,12 +594,10 @@ struct NodeOptimizer::Impl {
       }
       for (size_t i = 0; i < cones.hop_nodes.size(); ++i) {
         const int n = cones.hop_nodes[i];
-        const std::vector<char> forbidden = forbidden_relocation_vertices(original, all.layout, n);
-        const std::vector<char> near = no.keep_nodes_apart
-                                           ? next_to_other_nodes(original, all.layout, n)
-                                           : std::vector<char>(forbidden.size(), 0);
+        const std::vector<char> forbidden =
+            forbidden_relocation_vertices(original, all.layout, n, no.keep_nodes_apart);
         for (int w : cones.hop_targets[i])
-          if (!forbidden[w] && !near[w] &&
+          if (!forbidden[w] &&
               move_node_and_reroute(all.mesh, all.layout, n, w, no.relocation, &reroute)) {
             ++moved;
             break;

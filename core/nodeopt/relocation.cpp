@@ -96,7 +96,7 @@ int choose_relocation_vertex(const TriMesh& mesh, const TriMesh& original,
 }
 
 std::vector<char> forbidden_relocation_vertices(const TriMesh& mesh, const Layout& layout,
-                                                int node_index) {
+                                                int node_index, bool keep_apart) {
   std::vector<char> out(mesh.n_vertices(), 0);
   for (auto vh : mesh.vertices())
     if (mesh.is_boundary(vh)) out[vh.idx()] = 1;
@@ -111,6 +111,10 @@ std::vector<char> forbidden_relocation_vertices(const TriMesh& mesh, const Layou
   }
   for (size_t n = 0; n < layout.nodes.size(); ++n)
     if (static_cast<int>(n) != node_index) out[layout.nodes[n].vertex] = 1;
+  if (keep_apart) {
+    const std::vector<char> near = next_to_other_nodes(mesh, layout, node_index);
+    for (size_t v = 0; v < out.size(); ++v) out[v] |= near[v];
+  }
   return out;
 }
 
