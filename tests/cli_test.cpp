@@ -304,6 +304,10 @@ TEST(Cli, OptimizeMovesTheSketchedNodesAndRemovesFoldovers) {
   EXPECT_EQ(after["metrics"]["foldovers"].get<int>(), 0);
   EXPECT_TRUE(after["structurally_equivalent"].get<bool>());
   EXPECT_LT(after["E_final"].get<double>(), 0.5 * after["E_init"].get<double>());
+  // A run that embeds at its final state is not repeated with nodes kept apart.
+  EXPECT_FALSE(after["node_optimization"]["keep_nodes_apart"].get<bool>());
+  EXPECT_FALSE(after["node_optimization"].contains("keep_apart_retry"));
+  EXPECT_FALSE(after["node_optimization"]["fewest_foldovers_reverted"].get<bool>());
   ASSERT_GT(after["steps"].size(), 0u);
   double previous = after["E_init"].get<double>();
   for (const auto& step : after["steps"]) {
@@ -311,6 +315,33 @@ TEST(Cli, OptimizeMovesTheSketchedNodesAndRemovesFoldovers) {
     EXPECT_LE(step["E"].get<double>(), previous * (1 + 1e-12));
     previous = step["E"].get<double>();
   }
+}
+
+// --keep-nodes-apart is passed to the node optimization and recorded (the report's
+// node_optimization.keep_nodes_apart; no retry then), and it excludes --no-keep-nodes-apart.
+// NodeOptOptions::keep_nodes_apart itself is tested in orientation_displaced_test.cpp, the
+// retry in sizing_retry_cli_test.cpp.
+TEST(Cli, KeepNodesApartIsPassedOnAndRecorded) {
+  const std::string dir = test::temp_dir("cli_keep_apart");
+  std::string out;
+  ASSERT_EQ(test::run_command(cli("optimize --keep-nodes-apart --quiet --mesh " + kMesh +
+                                  " --layout " + kLayout + " --out " + dir),
+                              &out),
+            0)
+      << out;
+  const auto report = read_json(dir + "/report.json");
+  const auto& node = report["node_optimization"];
+  EXPECT_TRUE(node["keep_nodes_apart"].get<bool>());
+  EXPECT_FALSE(node.contains("keep_apart_retry"));
+  EXPECT_EQ(report["metrics"]["foldovers"].get<int>(), 0);
+  EXPECT_TRUE(report["structurally_equivalent"].get<bool>());
+  EXPECT_LT(report["E_final"].get<double>(), 0.5 * report["E_init"].get<double>());
+  EXPECT_EQ(test::run_command(cli("optimize --keep-nodes-apart --no-keep-nodes-apart --mesh " +
+                                  kMesh + " --layout " + kLayout + " --out " + dir),
+                              &out),
+            1)
+      << out;
+  EXPECT_NE(out.find("excludes"), std::string::npos) << out;
 }
 
 // --time-limit: the node movement ends at the limit and the run finishes from the state reached

@@ -1,12 +1,14 @@
-// quadsketch-cli optimize's sizing retry: when the sizing field is left to its default (off)
-// and fold-overs remain after the node optimization, the layout is optimized again from the
-// input with the sizing field, and that run is taken when it ends with fewer fold-overs. The
-// case is the paper's rocker-arm with its voxel-cage layout (`cage-layout --simplify`), which
-// a run with the field frame's orientation sectors only (`--orientation-sectors field`, the
-// only ones before session 26) leaves with fold-overs next to bad cones (docs/benchmarks.md
-// sessions 19-25). The default sectors (the solution frame's where the field frame's fail) now
-// embed it without the retry. Labelled slow (tests/CMakeLists.txt): about 100 s in a Release
-// build.
+// quadsketch-cli optimize's retries: when fold-overs remain after the node optimization (or
+// its fold-over removal fell back to an earlier state), the layout is optimized again from the
+// input with nodes kept apart (unless --keep-nodes-apart or --no-keep-nodes-apart was given),
+// then, when fold-overs still remain, with the sizing field (unless --sizing or --no-sizing was
+// given); each retry is taken when it ends better. The case is the paper's rocker-arm with its
+// voxel-cage layout (`cage-layout --simplify`), which a run with the field frame's orientation
+// sectors only (`--orientation-sectors field`, the only ones before session 26) leaves with
+// fold-overs next to bad cones (docs/benchmarks.md sessions 19-25). The default sectors (the
+// solution frame's where the field frame's fail) embed it at an earlier state of the descent,
+// and the retry with nodes kept apart at its final state, at a lower E. Labelled slow
+// (tests/CMakeLists.txt): about 4-5 minutes in a Release build.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -66,12 +68,14 @@ std::string* SizingRetry::out_ = nullptr;
 std::string* SizingRetry::layout_ = nullptr;
 int SizingRetry::cage_code_ = -1;
 
-// Sizing left to its default, field-frame sectors: fold-overs remain without sizing (the
-// premise, in the report), the retry with sizing ends without any, and its result is what is
-// written.
+// Sizing left to its default, nodes not kept apart, field-frame sectors: fold-overs remain
+// without sizing (the premise, in the report), the retry with sizing ends without any, and its
+// result is what is written.
 TEST_F(SizingRetry, DefaultRunRetriesWithTheSizingFieldWhenFoldOversRemain) {
   std::string log;
-  const auto report = optimize("default", "--orientation-sectors field", &log);
+  const auto report =
+      optimize("default", "--orientation-sectors field --no-keep-nodes-apart", &log);
+  EXPECT_FALSE(report["node_optimization"].contains("keep_apart_retry"));
   ASSERT_TRUE(report["node_optimization"].contains("sizing_retry")) << log;
   const auto& retry = report["node_optimization"]["sizing_retry"];
   ASSERT_GT(retry["foldovers_without"].get<int>(), 0) << "the case must fold without sizing";
@@ -86,25 +90,56 @@ TEST_F(SizingRetry, DefaultRunRetriesWithTheSizingFieldWhenFoldOversRemain) {
       << log;
 }
 
-// An explicit --no-sizing is the user's choice: no retry, the fold-overs stay (and are
-// reported).
+// An explicit --no-sizing and --no-keep-nodes-apart are the user's choice: no retry, the
+// fold-overs stay (and are reported).
 TEST_F(SizingRetry, ExplicitNoSizingDoesNotRetry) {
   std::string log;
-  const auto report =
-      optimize("no_sizing", "--no-sizing --orientation-sectors field --quiet", &log);
+  const auto report = optimize(
+      "no_sizing", "--no-sizing --no-keep-nodes-apart --orientation-sectors field --quiet", &log);
   EXPECT_FALSE(report["node_optimization"].contains("sizing_retry"));
+  EXPECT_FALSE(report["node_optimization"].contains("keep_apart_retry"));
+  EXPECT_FALSE(report["node_optimization"]["keep_nodes_apart"].get<bool>());
   EXPECT_FALSE(report["parameterization"]["sizing"].get<bool>());
   EXPECT_GT(report["metrics"]["foldovers"].get<int>(), 0);
 }
 
-// The default run (default sectors): the field frame's orientation constraints leave
-// fold-overs, the solution frame's remove them all, so no retry is needed and the layout embeds
-// without the sizing field.
-TEST_F(SizingRetry, DefaultSectorsEmbedWithoutTheRetry) {
+// Field-frame sectors, both retries left to the default: fold-overs remain (the premise, in the
+// report), the first retry keeps the nodes apart and ends without any, so the sizing field is
+// not tried, and the retry's result is what is written.
+TEST_F(SizingRetry, DefaultRunRetriesWithNodesKeptApartFirst) {
   std::string log;
-  const auto report = optimize("default_sectors", "--quiet", &log);
+  const auto report = optimize("apart", "--orientation-sectors field", &log);
+  const auto& node = report["node_optimization"];
+  ASSERT_TRUE(node.contains("keep_apart_retry")) << log;
+  const auto& retry = node["keep_apart_retry"];
+  ASSERT_GT(retry["foldovers_without"].get<int>(), 0) << "the case must fold without the retry";
+  EXPECT_EQ(retry["foldovers_with"].get<int>(), 0);
+  EXPECT_TRUE(retry["used"].get<bool>());
+  EXPECT_TRUE(node["keep_nodes_apart"].get<bool>());
+  EXPECT_FALSE(node.contains("sizing_retry"));
+  EXPECT_FALSE(report["parameterization"]["sizing"].get<bool>());
+  EXPECT_EQ(node["foldovers_final"].get<int>(), 0);
+  EXPECT_EQ(report["metrics"]["foldovers"].get<int>(), 0);
+  EXPECT_TRUE(report["structurally_equivalent"].get<bool>());
+  EXPECT_DOUBLE_EQ(report["E_final"].get<double>(), retry["E_final_with"].get<double>());
+  EXPECT_NE(log.find("optimizing again from the input with nodes kept apart"), std::string::npos)
+      << log;
+  std::printf(
+      "[stat] rocker-arm cage layout, field sectors: %d fold-overs at E %.6g, kept apart "
+      "0 at E %.6g\n",
+      retry["foldovers_without"].get<int>(), retry["E_final_without"].get<double>(),
+      retry["E_final_with"].get<double>());
+}
+
+// Default sectors, nodes not kept apart: the field frame's orientation constraints leave
+// fold-overs, the solution frame's remove them all, so no sizing retry is needed and the layout
+// embeds without the sizing field.
+TEST_F(SizingRetry, DefaultSectorsEmbedThroughTheSolutionFrame) {
+  std::string log;
+  const auto report = optimize("default_sectors", "--no-keep-nodes-apart --quiet", &log);
   const auto& node = report["node_optimization"];
   EXPECT_FALSE(node.contains("sizing_retry")) << log;
+  EXPECT_FALSE(node.contains("keep_apart_retry")) << log;
   EXPECT_FALSE(report["parameterization"]["sizing"].get<bool>());
   EXPECT_GT(node["foldovers_before_orientation"].get<int>(), 0);
   EXPECT_EQ(node["fold_removal"].get<std::string>(), "orientation");
@@ -114,9 +149,37 @@ TEST_F(SizingRetry, DefaultSectorsEmbedWithoutTheRetry) {
   EXPECT_TRUE(report["structurally_equivalent"].get<bool>());
   EXPECT_EQ(report["bad_cones"].get<int>(), 0);
   std::printf(
-      "[stat] rocker-arm cage layout, default sectors: E %.6g, %d fold-overs before the "
-      "constraints, 0 after\n",
-      report["E_final"].get<double>(), node["foldovers_before_orientation"].get<int>());
+      "[stat] rocker-arm cage layout, default sectors, nodes not kept apart: E %.6g, %d "
+      "fold-overs before the constraints, 0 after, earlier state %d\n",
+      report["E_final"].get<double>(), node["foldovers_before_orientation"].get<int>(),
+      int(node["fewest_foldovers_reverted"].get<bool>()));
+}
+
+// All defaults: when the fold-over removal embeds the layout only at an earlier state (the
+// accepted state with the fewest fold-overs), the run with nodes kept apart is tried too and
+// written when it ends without fold-overs at a lower E.
+TEST_F(SizingRetry, DefaultRunTakesNodesKeptApartWhenItEndsLower) {
+  std::string log;
+  const auto report = optimize("all_defaults", "", &log);
+  const auto& node = report["node_optimization"];
+  ASSERT_TRUE(node.contains("keep_apart_retry")) << log;
+  const auto& retry = node["keep_apart_retry"];
+  ASSERT_TRUE(retry["fell_back_without"].get<bool>()) << "the case must fall back by default";
+  EXPECT_EQ(retry["foldovers_without"].get<int>(), 0);
+  EXPECT_EQ(retry["foldovers_with"].get<int>(), 0);
+  EXPECT_LT(retry["E_final_with"].get<double>(), retry["E_final_without"].get<double>());
+  EXPECT_TRUE(retry["used"].get<bool>());
+  EXPECT_TRUE(node["keep_nodes_apart"].get<bool>());
+  EXPECT_FALSE(node.contains("sizing_retry"));
+  EXPECT_EQ(report["metrics"]["foldovers"].get<int>(), 0);
+  EXPECT_TRUE(report["structurally_equivalent"].get<bool>());
+  EXPECT_EQ(report["bad_cones"].get<int>(), 0);
+  EXPECT_DOUBLE_EQ(report["E_final"].get<double>(), retry["E_final_with"].get<double>());
+  EXPECT_NE(log.find("fell back to an earlier state"), std::string::npos) << log;
+  std::printf(
+      "[stat] rocker-arm cage layout, defaults: E %.6g at an earlier state, kept apart "
+      "E %.6g\n",
+      retry["E_final_without"].get<double>(), retry["E_final_with"].get<double>());
 }
 
 }  // namespace

@@ -112,10 +112,19 @@ int main(int argc, char** argv) {
                     "Treat the sharp edges (--sharp-angle) as feature curves in the node "
                     "optimization: nodes on them slide along them and their vertices keep their "
                     "place (sharp edges keep their shape; higher E)");
-  cmd_opt->add_flag("--keep-nodes-apart", opt.keep_nodes_apart,
-                    "Never carry a moving node onto a vertex next to another node (no two nodes "
-                    "on one triangle): for dense layouts with a few edges per patch side, where "
-                    "nodes crowding together make the fold-over removal fail");
+  auto* apart_on = cmd_opt->add_flag_callback(
+      "--keep-nodes-apart", [&opt] { opt.keep_nodes_apart = true; },
+      "Never carry a moving node onto a vertex next to another node (no two nodes on one "
+      "triangle), for dense layouts with a few edges per patch side. Off by default, but "
+      "without --keep-nodes-apart or --no-keep-nodes-apart a node optimization whose fold-over "
+      "removal leaves fold-overs or falls back to an earlier state is run again with it and "
+      "kept when it ends better");
+  cmd_opt
+      ->add_flag_callback(
+          "--no-keep-nodes-apart", [&opt] { opt.keep_nodes_apart = false; },
+          "Nodes may move next to each other, and no retry with "
+          "--keep-nodes-apart")
+      ->excludes(apart_on);
   cmd_opt->add_flag("--orientation", opt.orientation,
                     "With --no-node-opt: when the parameterization has fold-overs, solve it "
                     "again with strict orientation constraints (the fixed nodes' fold-over "

@@ -43,7 +43,9 @@ struct OptimizeOptions {
   std::string orientation_sectors = "auto";
   bool no_sliding = false;        //!< nodes on curves stay (NodeOptOptions::slide_on_curves off)
   bool keep_sharp_edges = false;  //!< NodeOptOptions::sharp_edges_as_curves
-  bool keep_nodes_apart = false;  //!< NodeOptOptions::keep_nodes_apart
+  //! NodeOptOptions::keep_nodes_apart; unset: off, with a retry with it when the fold-over
+  //! removal leaves fold-overs or falls back to an earlier state.
+  std::optional<bool> keep_nodes_apart;
   //! Curl-reducing sizing field (ParamOptions::sizing); unset: the library default.
   std::optional<bool> sizing;
   double sharp_angle_deg = 35.0;

@@ -432,6 +432,12 @@ void App::draw_pipeline_options() {
     ImGui::SetTooltip(
         "Nodes on sharp edges slide along them and no vertex on a sharp edge is moved: sharp "
         "edges keep their shape, at a higher E (--keep-sharp-edges)");
+  ImGui::Checkbox("Keep nodes apart", &o.keep_nodes_apart);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip(
+        "No node moves onto a vertex next to another node (no two nodes on one triangle): for "
+        "dense layouts with a few edges per patch side, where crowded nodes keep fold-overs "
+        "(--keep-nodes-apart)");
   float alpha = float(o.alpha);
   if (ImGui::SliderFloat("alpha (damping)", &alpha, 0.05f, 1.0f, "%.2f")) o.alpha = alpha;
   if (ImGui::IsItemHovered())
@@ -465,6 +471,7 @@ void App::draw_pipeline_options() {
     o.max_steps = defaults.max_steps;
     o.descent_steps = defaults.descent_steps;
     o.keep_sharp_edges = defaults.keep_sharp_edges;
+    o.keep_nodes_apart = defaults.keep_nodes_apart;
     o.remove_foldovers = defaults.remove_foldovers;
     o.alpha = defaults.alpha;
   }

@@ -214,6 +214,7 @@ NodeOptOptions editor_node_options(const WorkerOptions& o) {
   no.max_steps = o.descent_steps;
   no.alpha = o.alpha;
   no.sharp_edges_as_curves = o.keep_sharp_edges;
+  no.keep_nodes_apart = o.keep_nodes_apart;
   no.stiffen_at_end = false;
   return no;
 }

@@ -52,6 +52,9 @@ struct WorkerOptions {
   double alpha = 0.75;            //!< initial damping α of node-optimization steps
   int descent_steps = 25;         //!< descent steps before the first hop sweep (--steps)
   bool keep_sharp_edges = false;  //!< sharp edges as feature curves (--keep-sharp-edges)
+  //! No moving node is carried next to another node (NodeOptOptions::keep_nodes_apart,
+  //! --keep-nodes-apart); the editor has no automatic retry with it.
+  bool keep_nodes_apart = false;
   //! Without node optimization: when the parameterization folds, solve it again with strict
   //! orientation constraints (`optimize --no-node-opt --orientation`); the node optimization
   //! removes fold-overs at its end in any case.
