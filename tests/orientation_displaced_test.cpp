@@ -3,8 +3,9 @@
 // (`perturb --rings 2 --seed 1`, as scripts/bench.sh does), then optimized without the sizing
 // field. With sectors in the field frame the constrained last solve was infeasible next to
 // crowded nodes and 4 fold-overs remained (session 26); with sectors turned to the solution
-// (SectorFrame::kSolution, the default) none remain. Labelled slow (two optimizations, about
-// 35 s in a Release build).
+// (SectorFrame::kSolution, the default) none remain. Also the optimizer's last fallback, the
+// initial state (NodeOptOptions::initial_fallback), and NodeOptOptions::keep_nodes_apart here.
+// Labelled slow (six optimizations, about a minute in a Release build).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -115,6 +116,59 @@ TEST(OrientationDisplaced, KeepNodesApartLeavesNoNewNodesOnATriangle) {
   EXPECT_GT(pairs[0], 0) << "without the option nodes should move next to others (the premise)";
   EXPECT_EQ(pairs[1], 0);
   EXPECT_LT(r[1].E_descent, r[1].E_init);
+}
+
+// NodeOptOptions::initial_fallback: with nodes kept apart the displaced spot's descent ends
+// where the orientation constraints leave fold-overs at the final state and at the earlier
+// states tried (session 27: 31 after stiffening), while its initial state, folded as it is,
+// embeds. The fold-over removal then returns the initial state, oriented: no fold-overs, the
+// input's node vertices, arc routes and vertex positions.
+TEST(OrientationDisplaced, InitialStateIsTheLastFallback) {
+  const std::string dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
+  const QuadImportResult imp = import_spot(dir);
+  const Layout displaced = displace(imp);
+  NodeOptResult r[2];
+  for (int fallback = 0; fallback < 2; ++fallback) {
+    NodeOptOptions no;
+    no.keep_nodes_apart = true;
+    no.initial_fallback = fallback == 1;
+    r[fallback] = optimize_nodes(imp.mesh, displaced, PipelineOptions{}, no);
+    int attempts = 0;
+    for (const StepReport& s : r[fallback].reports) attempts += s.phase == "orientation";
+    std::printf(
+        "[stat] displaced spot, nodes kept apart, initial fallback %d: fold-overs %d -> %d -> "
+        "%d, E %.6g -> %.6g -> %.6g, %d orientation attempts, reverted: polish %d fewest %d "
+        "initial %d\n",
+        fallback, r[fallback].foldovers_init, r[fallback].foldovers_descent,
+        r[fallback].foldovers_final, r[fallback].E_init, r[fallback].E_descent, r[fallback].E_final,
+        attempts, int(r[fallback].polish_reverted), int(r[fallback].fewest_foldovers_reverted),
+        int(r[fallback].initial_reverted));
+  }
+  ASSERT_GT(r[0].foldovers_final, 0) << "the case must keep fold-overs without the fallback";
+  EXPECT_FALSE(r[0].initial_reverted);
+  const NodeOptResult& with = r[1];
+  ASSERT_GT(with.foldovers_init, 0) << "the initial state folds before the constraints";
+  EXPECT_TRUE(with.initial_reverted);
+  EXPECT_FALSE(with.fewest_foldovers_reverted);  // the initial state, not that one, returned
+  EXPECT_FALSE(with.polish_reverted);
+  EXPECT_EQ(with.foldovers_final, 0) << with.orientation.message;
+  EXPECT_TRUE(with.orientation_constraints);
+  EXPECT_TRUE(with.face_weights.empty());
+  // The initial state itself: the input's nodes, routes and positions.
+  ASSERT_EQ(with.layout.nodes.size(), displaced.nodes.size());
+  for (size_t n = 0; n < displaced.nodes.size(); ++n)
+    EXPECT_EQ(with.layout.nodes[n].vertex, displaced.nodes[n].vertex) << "node " << n;
+  ASSERT_EQ(with.layout.arcs.size(), displaced.arcs.size());
+  for (size_t i = 0; i < displaced.arcs.size(); ++i)
+    EXPECT_EQ(with.layout.arcs[i].path, displaced.arcs[i].path) << "arc " << i;
+  for (auto v : imp.mesh.vertices()) ASSERT_EQ(with.mesh.point(v), imp.mesh.point(v));
+  // The returned Pipeline holds that constrained solve.
+  ASSERT_TRUE(with.pipeline && with.pipeline->parameterization());
+  EXPECT_EQ(with.pipeline->parameterization()->foldovers, 0);
+  // Everything before the fallback is the same run.
+  EXPECT_EQ(with.steps, r[0].steps);
+  EXPECT_EQ(with.E_init, r[0].E_init);
 }
 
 }  // namespace

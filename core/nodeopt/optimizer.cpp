@@ -108,6 +108,20 @@ struct State {
   std::vector<CurvePoint> curve;     // per node (sliding nodes only)
 };
 
+// The same node vertices, arc routes and vertex positions.
+bool same_state(const State& a, const State& b) {
+  if (a.layout.nodes.size() != b.layout.nodes.size() ||
+      a.layout.arcs.size() != b.layout.arcs.size() || a.mesh.n_vertices() != b.mesh.n_vertices())
+    return false;
+  for (size_t n = 0; n < a.layout.nodes.size(); ++n)
+    if (a.layout.nodes[n].vertex != b.layout.nodes[n].vertex) return false;
+  for (size_t i = 0; i < a.layout.arcs.size(); ++i)
+    if (a.layout.arcs[i].path != b.layout.arcs[i].path) return false;
+  for (auto v : a.mesh.vertices())
+    if (a.mesh.point(v) != b.mesh.point(v)) return false;
+  return true;
+}
+
 std::vector<std::array<double, 3>> node_positions(const TriMesh& mesh, const Layout& layout) {
   std::vector<std::array<double, 3>> out;
   for (const auto& n : layout.nodes) {
@@ -202,6 +216,8 @@ struct NodeOptimizer::Impl {
   // current state has more: the second fallback of the fold-over removal.
   std::unique_ptr<State> fewest_folds;
   int fewest_folds_count = 0;
+  // The start (NodeOptOptions::initial_fallback): the last fallback of the fold-over removal.
+  std::unique_ptr<State> initial_state;
   int phase_halvings = 0;
   int stalled_steps = 0;      // accepted steps in a row with a gain below stall_gain
   double accepted_alpha = 0;  // α of the phase's last accepted descent step (0: none yet)
@@ -230,6 +246,8 @@ struct NodeOptimizer::Impl {
         alpha(no_in.alpha),
         step_budget(no_in.max_steps) {
     for (const auto& n : layout.nodes) state.anchor.push_back(vertex_surface_point(mesh, n.vertex));
+    if (no.orientation_at_end && no.initial_fallback)
+      initial_state = std::make_unique<State>(state);
     compute_movable();
     for (int n : movable) result.sliding_nodes += on_curve(state.layout.nodes[n].vertex);
     check_cancel(observer);
@@ -1033,7 +1051,7 @@ struct NodeOptimizer::Impl {
       node.pinned = pinned[n];
       // An earlier state where a newly pinned node stands elsewhere is no fallback any more.
       const auto vh = original.vertex_handle(node.vertex);
-      for (std::unique_ptr<State>* earlier : {&pre_polish, &fewest_folds}) {
+      for (std::unique_ptr<State>* earlier : {&pre_polish, &fewest_folds, &initial_state}) {
         if (!*earlier) continue;
         State& st = **earlier;
         st.layout.nodes[n].pinned = node.pinned;
@@ -1088,8 +1106,9 @@ struct NodeOptimizer::Impl {
     // all-faces orientation round ends this attempt.
     // \p obs: polled for cancellation and given the reports (the caller's observer; for the
     // speculative attempt its stop flag, the reports then streamed later by try_earlier).
+    // \p stiffen: stiffening follows here when fold-overs remain.
     auto remove_foldovers = [&](const State& st_in, const Evaluation& ev, NodeOptResult& out,
-                                bool fallback, Observer* obs) {
+                                bool fallback, bool stiffen, Observer* obs) {
       out.pipeline = ev.pipeline;
       out.descent_pipeline = ev.pipeline;
       out.E_descent = ev.E;
@@ -1135,7 +1154,7 @@ struct NodeOptimizer::Impl {
         r.phase = "orientation";
         emit_step(r, st_in.mesh, st_in.layout, out.reports, obs);
       }
-      if (no.stiffen_at_end && out.foldovers_final > 0 && !has_earlier)
+      if (stiffen && no.stiffen_at_end && out.foldovers_final > 0)
         stiffen_into(st_in, ev.pipeline, out);
     };
     // The fold-over removal at the state before the polish, solved speculatively
@@ -1167,21 +1186,23 @@ struct NodeOptimizer::Impl {
         try {
           out.evaluation = evaluate_fresh(earlier->mesh, earlier->layout, options, false);
           check_cancel(&speculative_stop);
-          remove_foldovers(*earlier, out.evaluation, out.result, later, &speculative_stop);
+          remove_foldovers(*earlier, out.evaluation, out.result, later, !has_earlier,
+                           &speculative_stop);
         } catch (...) {
           out.error = std::current_exception();
         }
         return out;
       });
     }
-    remove_foldovers(state, current, result, has_earlier, observer);
+    remove_foldovers(state, current, result, has_earlier, !has_earlier, observer);
     if (result.foldovers_final == 0) speculative_stop.stop = true;  // not needed
     // The descent and the polish lower E but can end where the fold-over removal fails although
     // it succeeds at an earlier state: the state before the first hop, then the accepted state
     // with the fewest fold-overs, are tried; a result with fewer fold-overs (equal: lower final
     // E) is taken.
     // \p later: another earlier state follows this one.
-    auto try_earlier = [&](std::unique_ptr<State>& earlier, bool& flag, bool later) {
+    // \p stiffen: as remove_foldovers'.
+    auto try_earlier = [&](std::unique_ptr<State>& earlier, bool& flag, bool later, bool stiffen) {
       if (result.foldovers_final == 0 || !earlier) return;
       check_cancel(observer);
       NodeOptResult alt;
@@ -1194,7 +1215,7 @@ struct NodeOptimizer::Impl {
           for (const StepReport& r : alt.reports) observer->on_step(r);
       } else {
         Evaluation ev = evaluate_fresh(earlier->mesh, earlier->layout, options, false);
-        remove_foldovers(*earlier, ev, alt, later, observer);
+        remove_foldovers(*earlier, ev, alt, later, stiffen, observer);
       }
       ++counters.fresh_pipelines;
       result.reports.insert(result.reports.end(), alt.reports.begin(), alt.reports.end());
@@ -1217,8 +1238,26 @@ struct NodeOptimizer::Impl {
       earlier.reset();
     };
     if (!no.orientation_at_end && !no.stiffen_at_end) pre_polish.reset(), fewest_folds.reset();
-    try_earlier(pre_polish, result.polish_reverted, try_fewest);
-    if (try_fewest) try_earlier(fewest_folds, result.fewest_foldovers_reverted, false);
+    // The initial state last (NodeOptOptions::initial_fallback), unless it is one of the states
+    // tried before; with orientation constraints only (no stiffening of it: the state tried
+    // before keeps its stiffening). Which states are the initial one, before try_earlier
+    // moves them.
+    const bool final_is_initial = initial_state && same_state(*initial_state, state);
+    const bool pre_polish_is_initial =
+        initial_state && pre_polish && same_state(*initial_state, *pre_polish);
+    const bool fewest_is_initial =
+        initial_state && try_fewest && same_state(*initial_state, *fewest_folds);
+    const bool try_initial =
+        initial_state && !final_is_initial && !pre_polish_is_initial && !fewest_is_initial;
+    try_earlier(pre_polish, result.polish_reverted, try_fewest, !has_earlier);
+    if (try_fewest)
+      try_earlier(fewest_folds, result.fewest_foldovers_reverted, false, !has_earlier);
+    bool initial_taken = false;
+    if (try_initial) try_earlier(initial_state, initial_taken, false, false);
+    if (initial_taken) result.polish_reverted = result.fewest_foldovers_reverted = false;
+    result.initial_reverted =
+        initial_taken || (result.fewest_foldovers_reverted && fewest_is_initial) ||
+        (result.polish_reverted && !result.fewest_foldovers_reverted && pre_polish_is_initial);
     if (has_earlier && no.stiffen_at_end && result.foldovers_final > 0)
       stiffen_into(state, result.descent_pipeline, result);
     if (stats) *stats = counters;

@@ -59,7 +59,9 @@ struct NodeOptOptions {
   //! removal fell back to the initial state (E 2.048); with it the optimized layout embeds: 0
   //! fold-overs, structurally equivalent, E 1.578 (session 27). Off by default: on spot imported
   //! onto itself (about 3 edges per patch side) and displaced two rings it leaves 31 fold-overs
-  //! where the default ends with none (`optimize --keep-nodes-apart`).
+  //! where the default ends with none (`optimize --keep-nodes-apart`). `quadsketch-cli optimize`
+  //! runs again with it when a run keeps fold-overs or falls back to an earlier state
+  //! (cmd_optimize.cpp, the keep-apart retry).
   bool keep_nodes_apart = false;
   //! Nodes whose step is shorter than this fraction of the mean edge length do not move; when
   //! no node moves the descent has converged.
@@ -200,6 +202,13 @@ struct NodeOptOptions {
   //! `orientation` is set by the optimizer (CLI: --no-orientation clears orientation_at_end).
   bool orientation_at_end = true;
   OrientationOptions orientation;
+  //! The last fallback of the fold-over removal (with orientation_at_end): when fold-overs
+  //! remain at the final state and at the earlier states tried (before the polish, the fewest
+  //! fold-overs), the initial state gets the orientation constraints too and is returned when
+  //! it ends with fewer fold-overs (NodeOptResult::initial_reverted): a layout that embeds where
+  //! the user put its nodes is not handed back folded. The exact cow (`import-quads --refine
+  //! 3`) kept 121 fold-overs after stiffening at E 2.19; its initial state embeds at E 3.62.
+  bool initial_fallback = true;
   bool stiffen_at_end = true;  //!< stiffening (§7.1) when fold-overs remain after that
   StiffeningOptions stiffening;
   //! Ends the node movement early when it returns true (a time limit): polled before each
@@ -233,6 +242,10 @@ struct NodeOptResult {
   //! many at a lower E_final) at the accepted state with the fewest fold-overs before the
   //! removal: that state was returned.
   bool fewest_foldovers_reverted = false;
+  //! The fold-over removal fell back to the initial state (by the fewest-fold-over fallback, the
+  //! one before the polish, or NodeOptOptions::initial_fallback): the node movement was given
+  //! up.
+  bool initial_reverted = false;
   int stiffening_iterations = 0;
   //! NodeOptOptions::stop (or DiscreteOptions::stop) ended the node movement before the
   //! descent and polish (the discrete sweeps) were over.
