@@ -5,7 +5,8 @@
 // crowded nodes and 4 fold-overs remained (session 26); with sectors turned to the solution
 // (SectorFrame::kSolution, the default) none remain. Also the optimizer's last fallback, the
 // initial state (NodeOptOptions::initial_fallback), and NodeOptOptions::keep_nodes_apart here.
-// Labelled slow (six optimizations, about a minute in a Release build).
+// And a normal matrix that rounding makes indefinite (the displaced pig). Labelled slow (six
+// optimizations and the pig's solve, about a minute and a half in a Release build).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -169,6 +170,38 @@ TEST(OrientationDisplaced, InitialStateIsTheLastFallback) {
   // Everything before the fallback is the same run.
   EXPECT_EQ(with.steps, r[0].steps);
   EXPECT_EQ(with.E_init, r[0].E_init);
+}
+
+// The interior-point method's normal matrix A + Cᵀ diag(λ/s) C loses positive definiteness to
+// rounding when λ/s grows large. On the displaced pig (`import-quads --refine 3`, `perturb
+// --rings 2 --seed 1`) with fixed nodes and field-frame sectors the 24th factorization failed
+// at λ/s ≈ 9e9 and the attempt ended with "matrix is not positive definite". With the clamp of
+// λ/s lowered there the method goes on and finds what the problem is: infeasible.
+TEST(OrientationDisplaced, IllConditionedNormalMatrixIsNoError) {
+  const std::string dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
+  QuadImportOptions io;
+  io.refine = 3;
+  const QuadImportResult imp =
+      import_quads(load_poly_mesh(dir + "/animals_basemesh/pig_pig.obj"), nullptr, io);
+  const Layout displaced = displace(imp);
+  PipelineOptions options;
+  options.param.orientation.enabled = true;
+  options.param.orientation.sector_frame = SectorFrame::kField;
+  Pipeline pipeline(imp.mesh, displaced, options);
+  pipeline.compute_field();
+  const Parameterization& p = pipeline.compute_parameterization();
+  const OrientationReport& r = p.orientation;
+  std::printf(
+      "[stat] displaced pig, fixed nodes, field-frame sectors: %d fold-overs, %d rounds, "
+      "%d factorizations, %d with a lower clamp: %s\n",
+      r.foldovers_before, r.rounds, r.sparse_factorizations, r.clamp_reductions, r.message.c_str());
+  ASSERT_TRUE(r.ran);
+  ASSERT_GT(r.foldovers_before, 0);
+  EXPECT_GT(r.clamp_reductions, 0) << "the case must reach the rounding limit (the premise)";
+  EXPECT_EQ(r.message.find("not positive definite"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("infeasible"), std::string::npos) << r.message;
+  EXPECT_FALSE(r.infeasible_faces.empty());
 }
 
 }  // namespace

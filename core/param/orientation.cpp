@@ -251,6 +251,7 @@ struct IpmOutcome {
   bool infeasible = false;
   bool ordered = false;  // the normal matrix's analysis used the given ordering
   int iterations = 0;
+  int clamp_reductions = 0;  // factorizations repeated with a lower λ/s clamp
   double primal_residual = 0;
 };
 
@@ -269,9 +270,25 @@ IpmOutcome interior_point(const Eigen::SparseMatrix<double>& A, const Eigen::Vec
   const double b_scale = 1.0 + b.lpNorm<Eigen::Infinity>();
 
   // λ/s is clamped: on active constraints it grows without bound as s → 0, and beyond ~1e10
-  // the normal matrix loses positive definiteness to rounding.
-  auto factorize = [&]() {
-    solver.factorize(normal.assemble(lambda.cwiseQuotient(s).cwiseMin(1e10)));
+  // the normal matrix loses positive definiteness to rounding. Where it does so below that
+  // bound, the clamp is lowered (by 100, down to kMinClamp) for this and the later iterations:
+  // a damped, inexact Newton step instead of an error (the displaced pig's initial state, its
+  // field-frame sectors: the 24th factorization failed at λ/s ≈ 9e9, and the method then
+  // found the constraints infeasible). Not once a feasible iterate is kept: the method then
+  // ends with it, as before.
+  constexpr double kMinClamp = 1e6;
+  double clamp = 1e10;
+  auto factorize = [&](bool may_lower_clamp) {
+    for (;;) {
+      try {
+        solver.factorize(normal.assemble(lambda.cwiseQuotient(s).cwiseMin(clamp)));
+        break;
+      } catch (const SolverError&) {
+        if (!may_lower_clamp || clamp <= kMinClamp) throw;
+        clamp /= 100;
+        ++out.clamp_reductions;
+      }
+    }
     out.ordered = solver.stats().hinted_analyses > 0;
   };
   // Direction for complementarity target r_c (Λ Δs + S Δλ = r_c).
@@ -293,7 +310,7 @@ IpmOutcome interior_point(const Eigen::SparseMatrix<double>& A, const Eigen::Vec
   // Starting point (Nocedal & Wright §16.6): one affine step from (y, s, 1), then shift s
   // and λ away from zero.
   {
-    factorize();
+    factorize(true);
     const Eigen::VectorXd rd = A * y - b - Ct * lambda;
     const Eigen::VectorXd rp = C * y - s - d;
     Eigen::VectorXd dy, ds, dl;
@@ -346,7 +363,7 @@ IpmOutcome interior_point(const Eigen::SparseMatrix<double>& A, const Eigen::Vec
       return finish();  // the multipliers diverge: no point satisfies C y ≥ d
     }
     try {
-      factorize();
+      factorize(y_best.size() == 0);
     } catch (const SolverError&) {
       if (y_best.size() > 0) return finish();  // rounding at the end of the iteration
       throw;
@@ -616,6 +633,7 @@ Eigen::VectorXd solve_in_frame(const TriMesh& mesh, const GeometryCache& g,
       ipm = interior_point(As, bs, rows.C, rows.d, y, o.max_iterations, o.tolerance, o.observer,
                            ordering);
       rep.sparse_factorizations += ipm.iterations;
+      rep.clamp_reductions += ipm.clamp_reductions;
       rep.ordered_rounds += ipm.ordered;
     }
     rep.iterations += ipm.iterations;
@@ -684,6 +702,7 @@ void add_effort(OrientationReport& into, const OrientationReport& other) {
   into.rounds += other.rounds;
   into.iterations += other.iterations;
   into.sparse_factorizations += other.sparse_factorizations;
+  into.clamp_reductions += other.clamp_reductions;
   into.ordered_rounds += other.ordered_rounds;
   into.time_s += other.time_s;
 }

@@ -132,6 +132,9 @@ struct OrientationReport {
   int rounds = 0;                 //!< QP solves
   int iterations = 0;             //!< interior-point iterations in total
   int sparse_factorizations = 0;  //!< CHOLMOD factorizations (primal solver only)
+  //! Factorizations of the primal solver repeated with a lower clamp of λ/s because rounding
+  //! made the normal matrix lose positive definiteness (no error then, see orientation.cpp).
+  int clamp_reductions = 0;
   //! sparse rounds whose normal matrices took the given ordering (solve_oriented's \p ordering)
   int ordered_rounds = 0;
   bool dense = false;                          //!< the last round used the dense dual solver
