@@ -178,11 +178,11 @@ TEST(GuiJob, WrapFreeHolesReachesTheField) {
   EXPECT_GT(wrapped->metrics.foldovers, 0);
 }
 
-// A Run that ends with fold-overs with the sizing field off says so and offers the sizing
-// field (what `quadsketch-cli optimize` retries with by itself); with it on, no such offer. The
+// A Run that ends with fold-overs says so and offers what `quadsketch-cli optimize` retries
+// with by itself: keeping the nodes apart and the sizing field, each only while it is off. The
 // case: the flat square whose free hole the field wraps ("Wrap free holes"), which folds
 // wherever the nodes go.
-TEST(GuiJob, RunEndingWithFoldOversOffersTheSizingField) {
+TEST(GuiJob, RunEndingWithFoldOversOffersTheRetries) {
   const test::MeshAndLayout sq = test::flat_square_with_free_hole();
   const Example ex{std::make_shared<const TriMesh>(sq.mesh), sq.layout};
   WorkerOptions options;
@@ -190,17 +190,26 @@ TEST(GuiJob, RunEndingWithFoldOversOffersTheSizingField) {
   options.wrap_free_holes = true;
   ASSERT_TRUE(options.node_optimization);
   ASSERT_FALSE(options.sizing);
+  ASSERT_FALSE(options.keep_nodes_apart);
   const auto plain = test::run_job(ex, options);
   ASSERT_EQ(plain->status, WorkerStatus::Finished) << plain->message;
   ASSERT_GT(plain->metrics.foldovers, 0) << "the case must fold: " << plain->message;
   std::printf("[stat] %s\n", plain->message.c_str());
-  EXPECT_NE(plain->message.find("fold-over(s) remain: turn on 'Sizing field' and Run again"),
+  EXPECT_NE(plain->message.find("fold-over(s) remain: turn on 'Keep nodes apart' or 'Sizing "
+                                "field' and Run again"),
             std::string::npos)
       << plain->message;
   options.sizing = true;
   const auto sized = test::run_job(ex, options);
   ASSERT_EQ(sized->status, WorkerStatus::Finished) << sized->message;
-  EXPECT_EQ(sized->message.find("turn on 'Sizing field'"), std::string::npos) << sized->message;
+  ASSERT_GT(sized->metrics.foldovers, 0) << sized->message;
+  EXPECT_NE(sized->message.find("turn on 'Keep nodes apart' and Run again"), std::string::npos)
+      << sized->message;
+  EXPECT_EQ(sized->message.find("'Sizing field'"), std::string::npos) << sized->message;
+  options.keep_nodes_apart = true;
+  const auto both = test::run_job(ex, options);
+  ASSERT_EQ(both->status, WorkerStatus::Finished) << both->message;
+  EXPECT_EQ(both->message.find("turn on"), std::string::npos) << both->message;
 }
 
 // "Sizing field" (WorkerOptions::sizing) reaches the parameterization: on the bundled sketch

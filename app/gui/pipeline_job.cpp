@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <set>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "core/base/errors.h"
 #include "core/layout/layout.h"
@@ -305,11 +307,27 @@ StepResult pipeline_step(WorkerState& state, const WorkerObserver& observer) {
         if (!near.empty()) prefix += " (infeasible near " + describe_nodes(job->layout, near) + ")";
       }
     }
-    // What `quadsketch-cli optimize` does by itself in this case (its sizing retry), offered.
-    if (end.foldovers_final > 0 && !state.options.sizing)
-      prefix += std::string(prefix.empty() ? "" : "; ") + std::to_string(end.foldovers_final) +
-                " fold-over(s) remain: turn on 'Sizing field' and Run again (the command line "
-                "retries with it by itself)";
+    if (end.initial_reverted)
+      prefix += std::string(prefix.empty() ? "" : "; ") +
+                "the moved layouts could not be unfolded: back at the initial state";
+    else if (end.fewest_foldovers_reverted)
+      prefix += std::string(prefix.empty() ? "" : "; ") +
+                "unfolded at an earlier step (the one with the fewest fold-overs)";
+    // What `quadsketch-cli optimize` does by itself in these cases (its retries), offered.
+    std::vector<std::string> offers;
+    if ((end.foldovers_final > 0 || end.initial_reverted || end.fewest_foldovers_reverted) &&
+        !state.options.keep_nodes_apart)
+      offers.push_back("'Keep nodes apart'");
+    if ((end.foldovers_final > 0 || end.initial_reverted) && !state.options.sizing)
+      offers.push_back("'Sizing field'");
+    if (!offers.empty()) {
+      prefix += std::string(prefix.empty() ? "" : "; ");
+      if (end.foldovers_final > 0)
+        prefix += std::to_string(end.foldovers_final) + " fold-over(s) remain: ";
+      prefix += "turn on " + offers[0] + (offers.size() > 1 ? " or " + offers[1] : "") +
+                " and Run again (the command line retries with " +
+                (offers.size() > 1 ? "them" : "it") + " by itself)";
+    }
     const double nodeopt_ms = ms_since(t);
     result = solve_for_display(*job, state, observer, true);
     result.metrics.nodeopt_ms = nodeopt_ms;
