@@ -143,7 +143,8 @@ int main(int argc, char** argv) {
       "--sizing", [&opt] { opt.sizing = true; },
       "Scale the parameterization's targets by the curl-reducing sizing field (paper §5.3; "
       "off by default, but without --sizing or --no-sizing a node optimization that ends "
-      "with fold-overs is run again with it and kept when it has fewer)");
+      "with fold-overs, or back at its initial state, is run again with it and kept when it "
+      "ends better)");
   cmd_opt
       ->add_flag_callback(
           "--no-sizing", [&opt] { opt.sizing = false; },
