@@ -169,15 +169,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       options.param.orientation.sector_frame = sector_frame;
       options.param.orientation.observer = &printer;
     }
-    // The keep-apart retry comes first: when the user left --keep-nodes-apart to the default
-    // (off) and the fold-over removal leaves fold-overs or has to fall back to the accepted
-    // state with the fewest fold-overs or to the initial state (the descent went where no
-    // orientation-constrained solve embeds the layout), the input is optimized again with
-    // NodeOptOptions::keep_nodes_apart, and that run is taken when it ends with fewer fold-overs,
-    // or as many at a lower E. Nodes crowding onto one triangle are what made the exact pig's
-    // optimized layouts fail (docs/benchmarks.md session 27: the default falls back to the initial
-    // state, E 2.048; kept apart, E 1.578 and no fold-overs). Not the default itself: crowded
-    // starts (the displaced spot) then keep fold-overs the default removes.
+    // Node optimization, then the retries below when it fails.
     nlohmann::json sizing_retry, apart_retry;
     if (!o.no_node_opt) {
       t0 = std::chrono::steady_clock::now();
@@ -193,39 +185,67 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       const auto fell_back = [](const NodeOptResult& r) {
         return r.fewest_foldovers_reverted || r.initial_reverted;
       };
-      if (may_retry_apart && !node_result->stopped &&
-          (node_result->foldovers_final > 0 || fell_back(*node_result))) {
+      // One retry from the input with \p run_options and \p apart (\p with names it, \p flags
+      // the options that decide it up front). The retry's run is adopted when \p better(retry,
+      // first) says so (`used` in the report entry, to which the caller adds its own fields).
+      struct Retry {
+        nlohmann::json entry;
+        bool used = false;
+        NodeOptResult run;
+      };
+      const auto retry = [&](const std::string& with, const std::string& flags,
+                             const PipelineOptions& run_options, bool apart, auto better) {
+        const NodeOptResult& first = *node_result;
         if (!common.quiet) {
           std::cerr << "optimize: ";
-          if (node_result->foldovers_final > 0)
-            std::cerr << node_result->foldovers_final << " fold-over(s) remain";
+          if (first.foldovers_final > 0)
+            std::cerr << first.foldovers_final << " fold-over(s) remain";
+          else if (first.initial_reverted)
+            std::cerr << "the fold-over removal fell back to the initial state";
           else
-            std::cerr << "the fold-over removal fell back to an earlier state (E "
-                      << node_result->E_final << ")";
-          std::cerr << "; optimizing again from the input with nodes kept apart "
-                       "(--keep-nodes-apart or --no-keep-nodes-apart decides this up front)\n";
+            std::cerr << "the fold-over removal fell back to an earlier state";
+          std::cerr << "; optimizing again from the input with " << with << " (" << flags
+                    << " decides this up front)\n";
         }
         const auto t_retry = std::chrono::steady_clock::now();
-        NodeOptResult second = optimize(*input_mesh, *input_layout, input_options, true);
-        const bool better = second.foldovers_final < node_result->foldovers_final ||
-                            (second.foldovers_final == node_result->foldovers_final &&
-                             second.E_final < node_result->E_final);
-        apart_retry = {{"foldovers_without", node_result->foldovers_final},
-                       {"E_final_without", node_result->E_final},
-                       {"fell_back_without", fell_back(*node_result)},
-                       {"foldovers_with", second.foldovers_final},
-                       {"E_final_with", second.E_final},
-                       {"used", better},
-                       {"time_s", seconds_since(t_retry)}};
+        NodeOptResult second = optimize(*input_mesh, *input_layout, run_options, apart);
+        const bool used = better(second, first);
+        nlohmann::json entry = {{"foldovers_without", first.foldovers_final},
+                                {"E_final_without", first.E_final},
+                                {"foldovers_with", second.foldovers_final},
+                                {"E_final_with", second.E_final},
+                                {"used", used}};
         if (!common.quiet)
-          std::cerr << "optimize: with nodes kept apart " << second.foldovers_final
+          std::cerr << "optimize: with " << with << " " << second.foldovers_final
                     << " fold-over(s) remain at E " << second.E_final << " ("
-                    << node_result->foldovers_final << " at E " << node_result->E_final
-                    << " without): " << (better ? "using it" : "keeping the run without it")
-                    << "\n";
-        if (better) {
+                    << first.foldovers_final << " at E " << first.E_final
+                    << " without): " << (used ? "using it" : "keeping the run without it") << "\n";
+        entry["time_s"] = seconds_since(t_retry);
+        return Retry{std::move(entry), used, std::move(second)};
+      };
+      // The keep-apart retry comes first: when the user left --keep-nodes-apart to the default
+      // (off) and the fold-over removal leaves fold-overs or has to fall back to the accepted
+      // state with the fewest fold-overs or to the initial state (the descent went where no
+      // orientation-constrained solve embeds the layout), the input is optimized again with
+      // NodeOptOptions::keep_nodes_apart, and that run is taken when it ends with fewer fold-overs,
+      // or as many at a lower E. Nodes crowding onto one triangle are what made the exact pig's
+      // optimized layouts fail (docs/benchmarks.md session 27: the default falls back to the
+      // initial state, E 2.048; kept apart, E 1.578 and no fold-overs). Not the default itself:
+      // crowded starts (the displaced spot) then keep fold-overs the default removes.
+      if (may_retry_apart && !node_result->stopped &&
+          (node_result->foldovers_final > 0 || fell_back(*node_result))) {
+        const bool fell_back_without = fell_back(*node_result);
+        Retry r = retry(
+            "nodes kept apart", "--keep-nodes-apart or --no-keep-nodes-apart", input_options, true,
+            [](const NodeOptResult& run, const NodeOptResult& first) {
+              return run.foldovers_final < first.foldovers_final ||
+                     (run.foldovers_final == first.foldovers_final && run.E_final < first.E_final);
+            });
+        apart_retry = std::move(r.entry);
+        apart_retry["fell_back_without"] = fell_back_without;
+        if (r.used) {
           keep_apart = true;
-          adopt(std::move(second));
+          adopt(std::move(r.run));
         }
       }
       // The sizing retry: when the user left the sizing field to the default (off) and
@@ -240,38 +260,21 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       // discrete baseline are run as asked.
       if (may_retry && !node_result->stopped &&
           (node_result->foldovers_final > 0 || node_result->initial_reverted)) {
-        if (!common.quiet) {
-          std::cerr << "optimize: ";
-          if (node_result->foldovers_final > 0)
-            std::cerr << node_result->foldovers_final << " fold-over(s) remain";
-          else
-            std::cerr << "the fold-over removal fell back to the initial state";
-          std::cerr << "; optimizing again from the input with the sizing field (--sizing or "
-                       "--no-sizing decides this up front)\n";
-        }
-        const auto t_retry = std::chrono::steady_clock::now();
         PipelineOptions sized = input_options;
         sized.param.sizing.enabled = true;
-        NodeOptResult second = optimize(*input_mesh, *input_layout, sized, keep_apart);
-        const bool better = second.foldovers_final < node_result->foldovers_final ||
-                            (second.foldovers_final == node_result->foldovers_final &&
-                             node_result->initial_reverted && !second.initial_reverted);
-        sizing_retry = {{"foldovers_without", node_result->foldovers_final},
-                        {"E_final_without", node_result->E_final},
-                        {"initial_without", node_result->initial_reverted},
-                        {"initial_with", second.initial_reverted},
-                        {"foldovers_with", second.foldovers_final},
-                        {"E_final_with", second.E_final},
-                        {"used", better},
-                        {"time_s", seconds_since(t_retry)}};
-        if (!common.quiet)
-          std::cerr << "optimize: with the sizing field " << second.foldovers_final
-                    << " fold-over(s) remain (" << node_result->foldovers_final
-                    << " without): " << (better ? "using it" : "keeping the run without it")
-                    << "\n";
-        if (better) {
+        const bool initial_without = node_result->initial_reverted;
+        Retry r = retry("the sizing field", "--sizing or --no-sizing", sized, keep_apart,
+                        [](const NodeOptResult& run, const NodeOptResult& first) {
+                          return run.foldovers_final < first.foldovers_final ||
+                                 (run.foldovers_final == first.foldovers_final &&
+                                  first.initial_reverted && !run.initial_reverted);
+                        });
+        sizing_retry = std::move(r.entry);
+        sizing_retry["initial_without"] = initial_without;
+        sizing_retry["initial_with"] = r.run.initial_reverted;
+        if (r.used) {
           options = sized;
-          adopt(std::move(second));
+          adopt(std::move(r.run));
         }
       }
       node_s = seconds_since(t0);

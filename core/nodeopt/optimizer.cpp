@@ -1254,10 +1254,13 @@ struct NodeOptimizer::Impl {
       try_earlier(fewest_folds, result.fewest_foldovers_reverted, false, !has_earlier);
     bool initial_taken = false;
     if (try_initial) try_earlier(initial_state, initial_taken, false, false);
+    // The state returned is the initial one: taken as such, or as the earlier state that won
+    // (the fewest-fold-over state when both earlier states were taken in turn).
     if (initial_taken) result.polish_reverted = result.fewest_foldovers_reverted = false;
     result.initial_reverted =
-        initial_taken || (result.fewest_foldovers_reverted && fewest_is_initial) ||
-        (result.polish_reverted && !result.fewest_foldovers_reverted && pre_polish_is_initial);
+        initial_taken ||
+        (result.fewest_foldovers_reverted ? fewest_is_initial
+                                          : result.polish_reverted && pre_polish_is_initial);
     if (has_earlier && no.stiffen_at_end && result.foldovers_final > 0)
       stiffen_into(state, result.descent_pipeline, result);
     if (stats) *stats = counters;
