@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include "core/layout/layout_io.h"
+#include "core/layout/perturb.h"
+#include "core/layout/quad_import.h"
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_io.h"
 #include "tests/fixtures.h"
@@ -342,6 +344,55 @@ TEST(Cli, KeepNodesApartIsPassedOnAndRecorded) {
             1)
       << out;
   EXPECT_NE(out.find("excludes"), std::string::npos) << out;
+  EXPECT_EQ(node["crowded_nodes"].get<int>(), 0);  // nothing separated without --separate-nodes
+  EXPECT_TRUE(node["separated_nodes"].empty());
+
+  // A displaced refined cube with nodes on each other's 1-ring: moved apart first with
+  // --separate-nodes (their ids recorded), left in place without it.
+  QuadImportOptions io;
+  io.refine = 2;  // arcs of 4 edges
+  const QuadImportResult cube = import_quads(test::quad_cube(2), nullptr, io);
+  Layout crowded;
+  for (unsigned seed = 1; seed < 40; ++seed) {
+    PerturbLayoutOptions po;
+    po.rings = 2;
+    po.seed = seed;
+    crowded = perturb_layout(cube.mesh, cube.layout, po).layout;
+    if (separate_nodes(cube.mesh, crowded, {}).moved_nodes.size() >= 2) break;
+  }
+  const SeparateNodesResult expected = separate_nodes(cube.mesh, crowded, {});
+  ASSERT_GE(expected.moved_nodes.size(), 2u);
+  save_mesh_obj(cube.mesh, dir + "/cube.obj");
+  save_layout(crowded, dir + "/crowded.layout.json", &cube.mesh);
+  for (const bool separate : {true, false}) {
+    ASSERT_EQ(test::run_command(
+                  cli(std::string("optimize --keep-nodes-apart --quiet --steps 2") +
+                      (separate ? " --separate-nodes" : "") + " --mesh " + dir +
+                      "/cube.obj --layout " + dir + "/crowded.layout.json --out " + dir + "/cube"),
+                  &out),
+              0)
+        << out;
+    const auto cube_report = read_json(dir + "/cube/report.json");
+    const auto& moved = cube_report["node_optimization"]["separated_nodes"];
+    if (separate) {
+      EXPECT_EQ(cube_report["node_optimization"]["crowded_nodes"].get<int>(),
+                static_cast<int>(expected.crowded_nodes.size()));
+      EXPECT_EQ(moved.get<std::vector<int>>(), expected.moved_nodes);
+    } else {
+      EXPECT_EQ(cube_report["node_optimization"]["crowded_nodes"].get<int>(), 0);
+      EXPECT_TRUE(moved.empty());
+    }
+  }
+  for (const char* other : {" --no-node-opt", " --discrete-relocation"}) {
+    EXPECT_EQ(test::run_command(cli(std::string("optimize --separate-nodes") + other + " --mesh " +
+                                    kMesh + " --layout " + kLayout + " --out " + dir),
+                                &out),
+              2)
+        << out;
+    EXPECT_NE(out.find("--separate-nodes applies to the continuous node optimization"),
+              std::string::npos)
+        << out;
+  }
 }
 
 // --time-limit: the node movement ends at the limit and the run finishes from the state reached

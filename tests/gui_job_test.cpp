@@ -10,6 +10,8 @@
 #include "app/gui/history.h"
 #include "app/gui/pipeline_job.h"
 #include "core/layout/layout_io.h"
+#include "core/layout/perturb.h"
+#include "core/layout/quad_import.h"
 #include "core/nodeopt/optimizer.h"
 #include "core/pipeline/pipeline.h"
 #include "tests/fixtures.h"
@@ -210,6 +212,45 @@ TEST(GuiJob, RunEndingWithFoldOversOffersTheRetries) {
   const auto both = test::run_job(ex, options);
   ASSERT_EQ(both->status, WorkerStatus::Finished) << both->message;
   EXPECT_EQ(both->message.find("turn on"), std::string::npos) << both->message;
+}
+
+// "Separate crowded nodes" (WorkerOptions::separate_nodes) reaches the node optimization: on a
+// displaced refined cube with nodes on each other's 1-ring, the first state the job shows has
+// the nodes where separate_nodes puts them; without it, where they were sketched.
+TEST(GuiJob, SeparateCrowdedNodesMovesThemBeforeTheRun) {
+  QuadImportOptions io;
+  io.refine = 2;
+  const QuadImportResult cube = import_quads(test::quad_cube(2), nullptr, io);
+  Layout crowded;
+  SeparateNodesResult expected;
+  for (unsigned seed = 1; seed < 40 && expected.moved_nodes.size() < 2; ++seed) {
+    PerturbLayoutOptions po;
+    po.rings = 2;
+    po.seed = seed;
+    crowded = perturb_layout(cube.mesh, cube.layout, po).layout;
+    expected = separate_nodes(cube.mesh, crowded, {});
+  }
+  ASSERT_GE(expected.moved_nodes.size(), 2u);
+  const Example ex{std::make_shared<const TriMesh>(cube.mesh), crowded};
+  for (const bool separate : {false, true}) {
+    WorkerOptions options = steps(2);
+    options.separate_nodes = separate;
+    const auto done = test::run_job(ex, options);
+    ASSERT_EQ(done->status, WorkerStatus::Finished) << done->message;
+    ASSERT_FALSE(done->node_history.empty());
+    EXPECT_EQ(done->energy_history.size(), 2u) << "one initial solve, one step";
+    const NodeFrame& first = *done->node_history.front();
+    const Layout& start = separate ? expected.layout : crowded;
+    for (int id : expected.moved_nodes) {
+      const auto it = std::find(first.ids.begin(), first.ids.end(), id);
+      ASSERT_NE(it, first.ids.end()) << "node " << id;
+      const auto& p = first.positions[it - first.ids.begin()];
+      const Vec3 want =
+          cube.mesh.point(cube.mesh.vertex_handle(start.nodes[start.node_index(id)].vertex));
+      EXPECT_NEAR((Vec3(p[0], p[1], p[2]) - want).norm(), 0, 1e-5)
+          << "node " << id << (separate ? " separated" : " as sketched");
+    }
+  }
 }
 
 // "Sizing field" (WorkerOptions::sizing) reaches the parameterization: on the bundled sketch

@@ -123,7 +123,9 @@ TEST(OrientationDisplaced, KeepNodesApartLeavesNoNewNodesOnATriangle) {
 // where the orientation constraints leave fold-overs at the final state and at the earlier
 // states tried (session 27: 31 after stiffening), while its initial state, folded as it is,
 // embeds. The fold-over removal then returns the initial state, oriented: no fold-overs, the
-// input's node vertices, arc routes and vertex positions.
+// input's node vertices, arc routes and vertex positions. Both runs leave the crowded nodes
+// where perturb put them; with them moved apart first (NodeOptOptions::separate_crowded_nodes)
+// the descent's final state embeds (session 29).
 TEST(OrientationDisplaced, InitialStateIsTheLastFallback) {
   const std::string dir = test::shared_meshes_dir();
   if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
@@ -134,6 +136,7 @@ TEST(OrientationDisplaced, InitialStateIsTheLastFallback) {
     NodeOptOptions no;
     no.keep_nodes_apart = true;
     no.initial_fallback = fallback == 1;
+    ASSERT_FALSE(no.separate_crowded_nodes);
     r[fallback] = optimize_nodes(imp.mesh, displaced, PipelineOptions{}, no);
     int attempts = 0;
     for (const StepReport& s : r[fallback].reports) attempts += s.phase == "orientation";
@@ -170,6 +173,28 @@ TEST(OrientationDisplaced, InitialStateIsTheLastFallback) {
   // Everything before the fallback is the same run.
   EXPECT_EQ(with.steps, r[0].steps);
   EXPECT_EQ(with.E_init, r[0].E_init);
+  EXPECT_TRUE(with.separated_nodes.empty());
+
+  // The crowded nodes moved apart before the descent: the final state embeds, with the node
+  // movement kept.
+  NodeOptOptions no;
+  no.keep_nodes_apart = true;
+  no.separate_crowded_nodes = true;
+  const NodeOptResult sep = optimize_nodes(imp.mesh, displaced, PipelineOptions{}, no);
+  std::printf(
+      "[stat] displaced spot, nodes kept apart and %zu of %d crowded nodes moved apart: "
+      "fold-overs %d -> %d -> %d, E %.6g -> %.6g -> %.6g, reverted: polish %d fewest %d "
+      "initial %d\n",
+      sep.separated_nodes.size(), sep.crowded_nodes, sep.foldovers_init, sep.foldovers_descent,
+      sep.foldovers_final, sep.E_init, sep.E_descent, sep.E_final, int(sep.polish_reverted),
+      int(sep.fewest_foldovers_reverted), int(sep.initial_reverted));
+  ASSERT_GT(sep.crowded_nodes, 0);
+  EXPECT_FALSE(sep.separated_nodes.empty());
+  EXPECT_LE(static_cast<int>(sep.separated_nodes.size()), sep.crowded_nodes);
+  EXPECT_NE(sep.E_init, r[0].E_init);  // it starts from the separated layout
+  EXPECT_EQ(sep.foldovers_final, 0) << sep.orientation.message;
+  EXPECT_FALSE(sep.initial_reverted);
+  EXPECT_LT(sep.E_final, sep.E_init);
 }
 
 // The interior-point method's normal matrix A + Cᵀ diag(λ/s) C loses positive definiteness to

@@ -125,6 +125,10 @@ int main(int argc, char** argv) {
           "Nodes may move next to each other, and no retry with "
           "--keep-nodes-apart")
       ->excludes(apart_on);
+  cmd_opt->add_flag("--separate-nodes", opt.separate_nodes,
+                    "Before the node optimization, move nodes that sit next to another node "
+                    "(on its vertex's 1-ring) apart, at most 2 edge rings; for displaced "
+                    "sketches with crowded nodes, best with --keep-nodes-apart");
   cmd_opt->add_flag("--orientation", opt.orientation,
                     "With --no-node-opt: when the parameterization has fold-overs, solve it "
                     "again with strict orientation constraints (the fixed nodes' fold-over "

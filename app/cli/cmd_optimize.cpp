@@ -97,6 +97,10 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
           "fold-overs with orientation constraints by default; --no-orientation turns that off)");
     if (o.time_limit_s > 0 && o.no_node_opt)
       throw InvalidInputError("--time-limit applies to the node optimization (not --no-node-opt)");
+    if (o.separate_nodes && (o.no_node_opt || o.discrete_relocation))
+      throw InvalidInputError(
+          "--separate-nodes applies to the continuous node optimization (not --no-node-opt or "
+          "--discrete-relocation)");
     if (o.orientation && o.no_orientation)
       throw InvalidInputError("--orientation and --no-orientation contradict each other");
     const SectorFrame sector_frame = o.orientation_sectors == "field" ? SectorFrame::kField
@@ -139,6 +143,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       no.slide_on_curves = !o.no_sliding;
       no.sharp_edges_as_curves = o.keep_sharp_edges;
       no.keep_nodes_apart = apart;
+      no.separate_crowded_nodes = o.separate_nodes;
       // Integer sizes put nodes exactly on shared iso-lines: fresh trial Pipelines there (see
       // NodeOptOptions::reuse_field).
       if (o.integer) no.reuse_field = false;
@@ -383,7 +388,9 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
           {"polish_reverted", node_result->polish_reverted},
           {"fewest_foldovers_reverted", node_result->fewest_foldovers_reverted},
           {"initial_reverted", node_result->initial_reverted},
-          {"keep_nodes_apart", keep_apart}};
+          {"keep_nodes_apart", keep_apart},
+          {"crowded_nodes", node_result->crowded_nodes},
+          {"separated_nodes", node_result->separated_nodes}};
       if (!apart_retry.is_null()) report["node_optimization"]["keep_apart_retry"] = apart_retry;
       if (!sizing_retry.is_null()) report["node_optimization"]["sizing_retry"] = sizing_retry;
       warn_about_infeasible_orientation(node_result->orientation, param.foldovers, pipeline.mesh(),

@@ -46,6 +46,7 @@ struct OptimizeOptions {
   //! NodeOptOptions::keep_nodes_apart; unset: off, with a retry with it when the fold-over
   //! removal leaves fold-overs or falls back to an earlier state.
   std::optional<bool> keep_nodes_apart;
+  bool separate_nodes = false;  //!< NodeOptOptions::separate_crowded_nodes
   //! Curl-reducing sizing field (ParamOptions::sizing); unset: the library default.
   std::optional<bool> sizing;
   double sharp_angle_deg = 35.0;

@@ -438,6 +438,11 @@ void App::draw_pipeline_options() {
         "No node moves onto a vertex next to another node (no two nodes on one triangle): for "
         "dense layouts with a few edges per patch side, where crowded nodes keep fold-overs "
         "(--keep-nodes-apart)");
+  ImGui::Checkbox("Separate crowded nodes", &o.separate_nodes);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip(
+        "Before the node optimization, nodes sketched next to another node (on its 1-ring) "
+        "move apart, at most 2 edge rings, keeping every patch (--separate-nodes)");
   float alpha = float(o.alpha);
   if (ImGui::SliderFloat("alpha (damping)", &alpha, 0.05f, 1.0f, "%.2f")) o.alpha = alpha;
   if (ImGui::IsItemHovered())
@@ -472,6 +477,7 @@ void App::draw_pipeline_options() {
     o.descent_steps = defaults.descent_steps;
     o.keep_sharp_edges = defaults.keep_sharp_edges;
     o.keep_nodes_apart = defaults.keep_nodes_apart;
+    o.separate_nodes = defaults.separate_nodes;
     o.remove_foldovers = defaults.remove_foldovers;
     o.alpha = defaults.alpha;
   }

@@ -217,6 +217,7 @@ NodeOptOptions editor_node_options(const WorkerOptions& o) {
   no.alpha = o.alpha;
   no.sharp_edges_as_curves = o.keep_sharp_edges;
   no.keep_nodes_apart = o.keep_nodes_apart;
+  no.separate_crowded_nodes = o.separate_nodes;
   no.stiffen_at_end = false;
   return no;
 }
@@ -232,6 +233,18 @@ StepResult pipeline_step(WorkerState& state, const WorkerObserver& observer) {
     job->layout = state.layout;
     job->options = pipeline_options(state.options);
     job->node_options = editor_node_options(state.options);
+    // Crowded nodes moved apart before the initial solve, so that it shows where the run
+    // starts (and the optimizer starts from that solve).
+    std::string separated;
+    if (job->node_options.separate_crowded_nodes) {
+      job->node_options.separate_crowded_nodes = false;
+      if (auto s = separate_movable_nodes(job->mesh, job->layout)) {
+        if (!s->moved_nodes.empty()) job->layout = std::move(s->layout);
+        if (!s->crowded_nodes.empty())
+          separated = std::to_string(s->moved_nodes.size()) + " of " +
+                      std::to_string(s->crowded_nodes.size()) + " crowded node(s) moved apart; ";
+      }
+    }
     for (const auto& node : job->layout.nodes)
       if (node.pinned) job->pinned_in_layout.insert(node.id);
     state.user = job;
@@ -251,7 +264,7 @@ StepResult pipeline_step(WorkerState& state, const WorkerObserver& observer) {
     StepResult result = solve_for_display(*job, state, observer, last);
     job->metrics = result.metrics;
     result.finished = !state.options.node_optimization;
-    result.message = "initial solve: " + result.message;
+    result.message = "initial solve: " + separated + result.message;
     if (orient && job->pipeline && job->pipeline->parameterization()) {
       const OrientationReport& r = job->pipeline->parameterization()->orientation;
       if (r.ran)

@@ -1,6 +1,7 @@
 #include "core/layout/perturb.h"
 
 #include <algorithm>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -73,7 +74,129 @@ class Perturber {
     return std::move(result_);
   }
 
+  // Moves every crowded node (another node within options.min_distance − 1 edge rings) that
+  // \p movable allows to the nearest vertex where it is not crowded, fewest rings first.
+  SeparateNodesResult separate(const std::vector<char>& movable,
+                               const SeparateNodesOptions& options) {
+    SeparateNodesResult out;
+    Layout& layout = result_.layout;
+    const int nn = static_cast<int>(layout.nodes.size());
+    for (int n = 0; n < nn; ++n)
+      if (crowded(n, layout.nodes[n].vertex, options.min_distance))
+        out.crowded_nodes.push_back(layout.nodes[n].id);
+    std::vector<char> moved(nn, 0);
+    for (int round = 0; round < options.rounds; ++round) {
+      bool any = false;
+      for (int n = 0; n < nn; ++n) {
+        if (!movable.empty() && !movable[n]) continue;
+        if (!crowded(n, layout.nodes[n].vertex, options.min_distance)) continue;
+        if (!may_move(n)) continue;
+        if (separate_node(n, options)) moved[n] = 1, any = true;
+      }
+      if (!any) break;
+    }
+    for (int n = 0; n < nn; ++n) {
+      if (moved[n]) out.moved_nodes.push_back(layout.nodes[n].id);
+      if (crowded(n, layout.nodes[n].vertex, options.min_distance))
+        out.still_crowded.push_back(layout.nodes[n].id);
+    }
+    out.layout = std::move(layout);
+    return out;
+  }
+
  private:
+  // Not pinned, no pinned arc, no loop arc, at least one arc: the nodes perturb may move.
+  bool may_move(int n) const {
+    const Layout& layout = result_.layout;
+    if (layout.nodes[n].pinned || node_arcs_[n].empty()) return false;
+    for (int a : node_arcs_[n]) {
+      const LayoutArc& arc = layout.arcs[a];
+      if (arc.pinned || (!arc.dangling() && arc.from == arc.to)) return false;
+    }
+    return true;
+  }
+
+  // Another node than n within min_distance − 1 edge rings of vertex v.
+  bool crowded(int n, int v, int min_distance) {
+    std::vector<int> ball = ball_vertices(v, min_distance - 1);
+    for (int w : ball)
+      if (vertex_node_[w] >= 0 && vertex_node_[w] != n) return true;
+    return vertex_node_[v] >= 0 && vertex_node_[v] != n;
+  }
+
+  // Vertices at 1 … rings edge rings from v0 (breadth-first order: nearer rings first).
+  std::vector<int> ball_vertices(int v0, int rings) {
+    ++current_stamp_;
+    std::vector<int> out;
+    stamp_[v0] = current_stamp_;
+    size_t begin = 0;
+    out.push_back(v0);
+    for (int r = 0; r < rings; ++r) {
+      const size_t end = out.size();
+      for (size_t i = begin; i < end; ++i) {
+        for (const auto w : mesh_.vv_range(VH(out[i]))) {
+          if (stamp_[w.idx()] == current_stamp_) continue;
+          stamp_[w.idx()] = current_stamp_;
+          out.push_back(w.idx());
+        }
+      }
+      begin = end;
+    }
+    out.erase(out.begin());
+    return out;
+  }
+
+  bool separate_node(int n, const SeparateNodesOptions& options) {
+    const Layout& layout = result_.layout;
+    const int v0 = layout.nodes[n].vertex;
+    const bool boundary = mesh_.is_boundary(VH(v0));
+    auto point = [&](int v) { return mesh_.point(VH(v)); };
+    // The nodes crowding n: the candidates farthest from them are tried first within a ring.
+    std::vector<Vec3> crowders;
+    for (int w : ball_vertices(v0, options.min_distance - 1))
+      if (vertex_node_[w] >= 0 && vertex_node_[w] != n) crowders.push_back(point(w));
+    struct Candidate {
+      int vertex, ring;
+      double clearance;
+    };
+    std::vector<Candidate> candidates;
+    for (int r = 1; r <= options.search_rings; ++r) {
+      std::vector<int> ring = ring_vertices_at(v0, r);
+      mark_reachable(n, v0, 2 * r + 2);
+      std::vector<int> reachable;
+      for (int v : ring)
+        if (stamp_[v] == current_stamp_) reachable.push_back(v);
+      for (int v : reachable) {
+        if (mesh_.is_boundary(VH(v)) != boundary) continue;
+        if (vertex_node_[v] >= 0 || crowded(n, v, options.min_distance)) continue;
+        double clearance = std::numeric_limits<double>::infinity();
+        for (const Vec3& c : crowders) clearance = std::min(clearance, (point(v) - c).norm());
+        candidates.push_back({v, r, clearance});
+      }
+    }
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [](const Candidate& a, const Candidate& b) {
+                       if (a.ring != b.ring) return a.ring < b.ring;
+                       return a.clearance > b.clearance;
+                     });
+    const int attempts = std::min<int>(options.max_attempts, static_cast<int>(candidates.size()));
+    for (int k = 0; k < attempts; ++k)
+      if (try_move(n, candidates[k].vertex)) return true;
+    return false;
+  }
+
+  // Vertices at exactly r edge rings from v0.
+  std::vector<int> ring_vertices_at(int v0, int r) {
+    std::vector<int> ball = ball_vertices(v0, r);
+    std::vector<int> inner = r > 1 ? ball_vertices(v0, r - 1) : std::vector<int>{};
+    std::sort(inner.begin(), inner.end());
+    std::vector<int> out;
+    for (int v : ball)
+      if (!std::binary_search(inner.begin(), inner.end(), v)) out.push_back(v);
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+
   // ---- ownership bookkeeping ----
   int edge_of(int u, int w) const {
     return mesh_.edge_handle(mesh_.find_halfedge(VH(u), VH(w))).idx();
@@ -362,6 +485,19 @@ class Perturber {
 };
 
 }  // namespace
+
+SeparateNodesResult separate_nodes(const TriMesh& mesh, const Layout& layout,
+                                   const std::vector<char>& movable,
+                                   const SeparateNodesOptions& options) {
+  if (options.min_distance < 1 || options.search_rings < 1)
+    throw InvalidInputError("separate_nodes: min_distance and search_rings must be at least 1");
+  if (!movable.empty() && movable.size() != layout.nodes.size())
+    throw InvalidInputError("separate_nodes: one movable flag per layout node expected");
+  PerturbLayoutOptions perturb;
+  perturb.rings = options.search_rings;
+  perturb.max_attempts = options.max_attempts;
+  return Perturber(mesh, layout, perturb).separate(movable, options);
+}
 
 PerturbResult perturb_layout(const TriMesh& mesh, const Layout& layout,
                              const PerturbLayoutOptions& options) {

@@ -13,6 +13,7 @@
 
 #include "core/base/timing.h"
 #include "core/field/curvature.h"
+#include "core/layout/validate.h"
 #include "core/nodeopt/discrete.h"
 #include "core/nodeopt/geodesic.h"
 
@@ -1271,11 +1272,28 @@ struct NodeOptimizer::Impl {
   }
 };
 
+std::optional<SeparateNodesResult> separate_movable_nodes(const TriMesh& mesh,
+                                                          const Layout& layout) {
+  // An invalid layout is left to the initial solve, which names its errors.
+  if (!validate_layout(mesh, layout).valid()) return std::nullopt;
+  std::vector<char> flags(layout.nodes.size(), 0);
+  for (int n : movable_nodes(mesh, layout)) flags[n] = 1;
+  return separate_nodes(mesh, layout, flags);
+}
+
 NodeOptimizer::NodeOptimizer(const TriMesh& mesh, const Layout& layout,
                              const PipelineOptions& options, const NodeOptOptions& node_options,
-                             Observer* observer, std::shared_ptr<Pipeline> start)
-    : impl_(std::make_unique<Impl>(mesh, layout, options, node_options, observer,
-                                   std::move(start))) {}
+                             Observer* observer, std::shared_ptr<Pipeline> start) {
+  std::optional<SeparateNodesResult> separated;
+  if (node_options.separate_crowded_nodes) separated = separate_movable_nodes(mesh, layout);
+  const bool moved = separated && !separated->moved_nodes.empty();
+  impl_ = std::make_unique<Impl>(mesh, moved ? separated->layout : layout, options, node_options,
+                                 observer, std::move(start));
+  if (separated) {
+    impl_->result.separated_nodes = separated->moved_nodes;
+    impl_->result.crowded_nodes = static_cast<int>(separated->crowded_nodes.size());
+  }
+}
 
 NodeOptimizer::~NodeOptimizer() = default;
 

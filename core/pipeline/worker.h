@@ -55,6 +55,9 @@ struct WorkerOptions {
   //! No moving node is carried next to another node (NodeOptOptions::keep_nodes_apart,
   //! --keep-nodes-apart); the editor has no automatic retry with it.
   bool keep_nodes_apart = false;
+  //! Nodes sketched next to another node are moved apart before the node optimization
+  //! (NodeOptOptions::separate_crowded_nodes, --separate-nodes).
+  bool separate_nodes = false;
   //! Without node optimization: when the parameterization folds, solve it again with strict
   //! orientation constraints (`optimize --no-node-opt --orientation`); the node optimization
   //! removes fold-overs at its end in any case.
