@@ -10,7 +10,6 @@
 
 #include "core/layout/layout_io.h"
 #include "core/layout/perturb.h"
-#include "core/layout/quad_import.h"
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_io.h"
 #include "tests/fixtures.h"
@@ -349,17 +348,8 @@ TEST(Cli, KeepNodesApartIsPassedOnAndRecorded) {
 
   // A displaced refined cube with nodes on each other's 1-ring: moved apart first with
   // --separate-nodes (their ids recorded), left in place without it.
-  QuadImportOptions io;
-  io.refine = 2;  // arcs of 4 edges
-  const QuadImportResult cube = import_quads(test::quad_cube(2), nullptr, io);
-  Layout crowded;
-  for (unsigned seed = 1; seed < 40; ++seed) {
-    PerturbLayoutOptions po;
-    po.rings = 2;
-    po.seed = seed;
-    crowded = perturb_layout(cube.mesh, cube.layout, po).layout;
-    if (separate_nodes(cube.mesh, crowded, {}).moved_nodes.size() >= 2) break;
-  }
+  const test::MeshAndLayout cube = test::crowded_refined_cube();
+  const Layout& crowded = cube.layout;
   const SeparateNodesResult expected = separate_nodes(cube.mesh, crowded, {});
   ASSERT_GE(expected.moved_nodes.size(), 2u);
   save_mesh_obj(cube.mesh, dir + "/cube.obj");

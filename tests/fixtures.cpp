@@ -13,9 +13,12 @@
 #include <map>
 #include <queue>
 #include <set>
+#include <stdexcept>
 
 #include "core/field/cross_field.h"
 #include "core/layout/layout_io.h"
+#include "core/layout/perturb.h"
+#include "core/layout/quad_import.h"
 #include "core/layout/routing.h"
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_checks.h"
@@ -421,6 +424,21 @@ MeshAndLayout voxel_surface(const std::vector<std::array<int, 3>>& voxels, int k
     }
   }
   return out;
+}
+
+MeshAndLayout crowded_refined_cube() {
+  QuadImportOptions io;
+  io.refine = 2;
+  QuadImportResult cube = import_quads(quad_cube(2), nullptr, io);
+  for (unsigned seed = 1; seed < 40; ++seed) {
+    PerturbLayoutOptions po;
+    po.rings = 2;
+    po.seed = seed;
+    Layout crowded = perturb_layout(cube.mesh, cube.layout, po).layout;
+    if (separate_nodes(cube.mesh, crowded, {}).moved_nodes.size() >= 2)
+      return {std::move(cube.mesh), std::move(crowded)};
+  }
+  throw std::runtime_error("crowded_refined_cube: no seed crowds the nodes");
 }
 
 MeshAndLayout genus2_polycube(int k) {

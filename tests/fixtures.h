@@ -90,6 +90,11 @@ MeshAndLayout voxel_surface(const std::vector<std::array<int, 3>>& voxels, int k
 //! columns (nodes of valence 3, 4 and 5).
 MeshAndLayout genus2_polycube(int k);
 
+//! The quad cube k = 2 imported with refine 2 (arcs of 4 edges), its layout displaced two rings
+//! (perturb_layout) by the first seed from 1 that puts nodes on each other's 1-ring so that
+//! separate_nodes moves at least two of them: `layout` is that crowded layout.
+MeshAndLayout crowded_refined_cube();
+
 //! Surface of the box [0,sx]×[0,sy]×[0,sz] (size {sx, sy, sz}) as a unit quad grid per side,
 //! outward oriented, shifted by \p offset.
 PolyMesh quad_box(std::array<int, 3> size, Vec3 offset = Vec3(0, 0, 0));

@@ -11,7 +11,6 @@
 #include "app/gui/pipeline_job.h"
 #include "core/layout/layout_io.h"
 #include "core/layout/perturb.h"
-#include "core/layout/quad_import.h"
 #include "core/nodeopt/optimizer.h"
 #include "core/pipeline/pipeline.h"
 #include "tests/fixtures.h"
@@ -218,18 +217,9 @@ TEST(GuiJob, RunEndingWithFoldOversOffersTheRetries) {
 // displaced refined cube with nodes on each other's 1-ring, the first state the job shows has
 // the nodes where separate_nodes puts them; without it, where they were sketched.
 TEST(GuiJob, SeparateCrowdedNodesMovesThemBeforeTheRun) {
-  QuadImportOptions io;
-  io.refine = 2;
-  const QuadImportResult cube = import_quads(test::quad_cube(2), nullptr, io);
-  Layout crowded;
-  SeparateNodesResult expected;
-  for (unsigned seed = 1; seed < 40 && expected.moved_nodes.size() < 2; ++seed) {
-    PerturbLayoutOptions po;
-    po.rings = 2;
-    po.seed = seed;
-    crowded = perturb_layout(cube.mesh, cube.layout, po).layout;
-    expected = separate_nodes(cube.mesh, crowded, {});
-  }
+  const test::MeshAndLayout cube = test::crowded_refined_cube();
+  const Layout& crowded = cube.layout;
+  const SeparateNodesResult expected = separate_nodes(cube.mesh, crowded, {});
   ASSERT_GE(expected.moved_nodes.size(), 2u);
   const Example ex{std::make_shared<const TriMesh>(cube.mesh), crowded};
   for (const bool separate : {false, true}) {

@@ -154,32 +154,24 @@ std::vector<int> nodes_next_to_others(const TriMesh& mesh, const Layout& layout)
 }
 
 TEST(SeparateNodes, CrowdedNodesMoveApartKeepingTheStructure) {
-  const QuadImportResult r = refined_cube(2, 2);  // arcs of 4 edges
-  // A displaced layout with nodes on each other's 1-ring (the first seed that gives some).
-  PerturbResult p;
-  std::vector<int> crowded;
-  for (unsigned seed = 1; seed < 40 && crowded.size() < 2; ++seed) {
-    PerturbLayoutOptions options;
-    options.rings = 2;
-    options.seed = seed;
-    p = perturb_layout(r.mesh, r.layout, options);
-    crowded = nodes_next_to_others(r.mesh, p.layout);
-  }
-  ASSERT_GE(crowded.size(), 2u) << "no perturbation crowded the nodes";
+  const test::MeshAndLayout r = test::crowded_refined_cube();  // the exact cube displaced
+  const Layout& displaced = r.layout;
+  const std::vector<int> crowded = nodes_next_to_others(r.mesh, displaced);
+  ASSERT_GE(crowded.size(), 2u);
 
-  const SeparateNodesResult s = separate_nodes(r.mesh, p.layout, {});
-  expect_valid_same_structure(r.mesh, p.layout, s.layout);
+  const SeparateNodesResult s = separate_nodes(r.mesh, displaced, {});
+  expect_valid_same_structure(r.mesh, displaced, s.layout);
   std::vector<int> listed = s.crowded_nodes;
   std::sort(listed.begin(), listed.end());
   EXPECT_EQ(listed, crowded);
   EXPECT_FALSE(s.moved_nodes.empty());
   EXPECT_EQ(nodes_next_to_others(r.mesh, s.layout), s.still_crowded);
   EXPECT_LT(s.still_crowded.size(), crowded.size());
-  for (size_t n = 0; n < p.layout.nodes.size(); ++n) {
-    const int id = p.layout.nodes[n].id;
+  for (size_t n = 0; n < displaced.nodes.size(); ++n) {
+    const int id = displaced.nodes[n].id;
     const bool moved =
         std::find(s.moved_nodes.begin(), s.moved_nodes.end(), id) != s.moved_nodes.end();
-    const int d = ring_distance(r.mesh, p.layout.nodes[n].vertex, s.layout.nodes[n].vertex);
+    const int d = ring_distance(r.mesh, displaced.nodes[n].vertex, s.layout.nodes[n].vertex);
     if (moved) {
       EXPECT_TRUE(std::find(crowded.begin(), crowded.end(), id) != crowded.end()) << id;
       EXPECT_GE(d, 1);
@@ -191,22 +183,24 @@ TEST(SeparateNodes, CrowdedNodesMoveApartKeepingTheStructure) {
 
   // Nodes that may not move stay: none movable, or the crowded ones pinned.
   const SeparateNodesResult none =
-      separate_nodes(r.mesh, p.layout, std::vector<char>(p.layout.nodes.size(), 0));
+      separate_nodes(r.mesh, displaced, std::vector<char>(displaced.nodes.size(), 0));
   EXPECT_TRUE(none.moved_nodes.empty());
-  EXPECT_EQ(layout_to_json(none.layout), layout_to_json(p.layout));
-  Layout pinned = p.layout;
+  EXPECT_EQ(layout_to_json(none.layout), layout_to_json(displaced));
+  Layout pinned = displaced;
   for (auto& node : pinned.nodes)
     if (std::find(crowded.begin(), crowded.end(), node.id) != crowded.end()) node.pinned = true;
   EXPECT_TRUE(separate_nodes(r.mesh, pinned, {}).moved_nodes.empty());
 
   // An exact layout has no crowded node and is returned as it is; bad options are refused.
-  const SeparateNodesResult exact = separate_nodes(r.mesh, r.layout, {});
+  const QuadImportResult cube = refined_cube(2, 2);
+  ASSERT_EQ(cube.mesh.n_vertices(), r.mesh.n_vertices());
+  const SeparateNodesResult exact = separate_nodes(cube.mesh, cube.layout, {});
   EXPECT_TRUE(exact.crowded_nodes.empty());
-  EXPECT_EQ(layout_to_json(exact.layout), layout_to_json(r.layout));
+  EXPECT_EQ(layout_to_json(exact.layout), layout_to_json(cube.layout));
   SeparateNodesOptions bad;
   bad.search_rings = 0;
-  EXPECT_THROW(separate_nodes(r.mesh, p.layout, {}, bad), InvalidInputError);
-  EXPECT_THROW(separate_nodes(r.mesh, p.layout, std::vector<char>(1, 1)), InvalidInputError);
+  EXPECT_THROW(separate_nodes(r.mesh, displaced, {}, bad), InvalidInputError);
+  EXPECT_THROW(separate_nodes(r.mesh, displaced, std::vector<char>(1, 1)), InvalidInputError);
 }
 
 TEST(PerturbCli, WritesAValidLayout) {
