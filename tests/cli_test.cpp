@@ -356,7 +356,7 @@ TEST(Cli, KeepNodesApartIsPassedOnAndRecorded) {
   save_layout(crowded, dir + "/crowded.layout.json", &cube.mesh);
   for (const bool separate : {true, false}) {
     ASSERT_EQ(test::run_command(
-                  cli(std::string("optimize --keep-nodes-apart --quiet --steps 2") +
+                  cli(std::string("optimize --keep-nodes-apart --steps 2") +
                       (separate ? " --separate-nodes" : "") + " --mesh " + dir +
                       "/cube.obj --layout " + dir + "/crowded.layout.json --out " + dir + "/cube"),
                   &out),
@@ -364,6 +364,7 @@ TEST(Cli, KeepNodesApartIsPassedOnAndRecorded) {
         << out;
     const auto cube_report = read_json(dir + "/cube/report.json");
     const auto& moved = cube_report["node_optimization"]["separated_nodes"];
+    EXPECT_EQ(out.find("crowded node(s) moved apart") != std::string::npos, separate) << out;
     if (separate) {
       EXPECT_EQ(cube_report["node_optimization"]["crowded_nodes"].get<int>(),
                 static_cast<int>(expected.crowded_nodes.size()));

@@ -156,7 +156,12 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
         warned_about_constraints =
             warn_about_released_constraints(*start->field(), "optimize (initial field)");
       }
-      return optimize_nodes(start_mesh, start_layout, run_options, no, &printer, start);
+      NodeOptResult result =
+          optimize_nodes(start_mesh, start_layout, run_options, no, &printer, start);
+      if (!common.quiet && result.crowded_nodes > 0)
+        std::cerr << "optimize: " << result.separated_nodes.size() << " of " << result.crowded_nodes
+                  << " crowded node(s) moved apart before the node optimization\n";
+      return result;
     };
     // After a run: its mesh, layout and the options of its final solve.
     const auto adopt = [&](NodeOptResult result) {
