@@ -241,23 +241,7 @@ class Perturber {
 
   // ---- candidates ----
   // Vertices at exactly `rings` BFS steps from v0 on the whole mesh.
-  std::vector<int> ring_vertices(int v0) {
-    ++current_stamp_;
-    std::vector<int> frontier{v0}, next;
-    stamp_[v0] = current_stamp_;
-    for (int r = 0; r < options_.rings && !frontier.empty(); ++r) {
-      next.clear();
-      for (int v : frontier) {
-        for (const auto w : mesh_.vv_range(VH(v))) {
-          if (stamp_[w.idx()] == current_stamp_) continue;
-          stamp_[w.idx()] = current_stamp_;
-          next.push_back(w.idx());
-        }
-      }
-      frontier.swap(next);
-    }
-    return frontier;
-  }
+  std::vector<int> ring_vertices(int v0) { return ring_vertices_at(v0, options_.rings); }
 
   // Stamps the vertices reachable from v0 within `depth` steps without entering another node
   // or another arc (the node's own arcs, about to be re-routed, do not count).
