@@ -147,17 +147,15 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       // Integer sizes put nodes exactly on shared iso-lines: fresh trial Pipelines there (see
       // NodeOptOptions::reuse_field).
       if (o.integer) no.reuse_field = false;
-      // The initial solve here rather than inside the optimizer, so that a layout that
-      // contradicts the curvature is reported before a long run rather than after it.
-      std::shared_ptr<Pipeline> start;
-      if (!warned_about_constraints) {
-        start = std::make_shared<Pipeline>(start_mesh, start_layout, run_options);
-        start->compute_parameterization();
-        warned_about_constraints =
-            warn_about_released_constraints(*start->field(), "optimize (initial field)");
+      // The optimizer's initial solve (of the layout it starts from, after --separate-nodes)
+      // reports a layout that contradicts the curvature before the long run rather than after.
+      NodeOptimizer optimizer(start_mesh, start_layout, run_options, no, &printer);
+      if (!warned_about_constraints)
+        warned_about_constraints = warn_about_released_constraints(
+            *optimizer.pipeline(&printer)->field(), "optimize (initial field)");
+      while (optimizer.step(&printer)) {
       }
-      NodeOptResult result =
-          optimize_nodes(start_mesh, start_layout, run_options, no, &printer, start);
+      NodeOptResult result = optimizer.finish(&printer);
       if (!common.quiet && result.crowded_nodes > 0)
         std::cerr << "optimize: " << result.separated_nodes.size() << " of " << result.crowded_nodes
                   << " crowded node(s) moved apart before the node optimization\n";

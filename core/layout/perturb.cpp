@@ -185,16 +185,24 @@ class Perturber {
     return false;
   }
 
-  // Vertices at exactly r edge rings from v0.
+  // Vertices at exactly r edge rings from v0 (breadth-first distance on the whole mesh), sorted.
   std::vector<int> ring_vertices_at(int v0, int r) {
-    std::vector<int> ball = ball_vertices(v0, r);
-    std::vector<int> inner = r > 1 ? ball_vertices(v0, r - 1) : std::vector<int>{};
-    std::sort(inner.begin(), inner.end());
-    std::vector<int> out;
-    for (int v : ball)
-      if (!std::binary_search(inner.begin(), inner.end(), v)) out.push_back(v);
-    std::sort(out.begin(), out.end());
-    return out;
+    ++current_stamp_;
+    std::vector<int> frontier{v0}, next;
+    stamp_[v0] = current_stamp_;
+    for (int k = 0; k < r && !frontier.empty(); ++k) {
+      next.clear();
+      for (int v : frontier) {
+        for (const auto w : mesh_.vv_range(VH(v))) {
+          if (stamp_[w.idx()] == current_stamp_) continue;
+          stamp_[w.idx()] = current_stamp_;
+          next.push_back(w.idx());
+        }
+      }
+      frontier.swap(next);
+    }
+    std::sort(frontier.begin(), frontier.end());
+    return frontier;
   }
 
   // ---- ownership bookkeeping ----
