@@ -19,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/base/atomic_file.h"
 #include "core/layout/layout_io.h"
 #include "tests/fixtures.h"
 
@@ -211,6 +212,8 @@ TEST(Signals, InterruptedRerunKeepsTheOldCompleteOutputs) {
             0)
       << log;
   ASSERT_EQ(check_folder(out, in.faces), "ok");
+  // The temporary file of a run killed outright: the rerun removes it.
+  write_file_atomic((fs::path(out) / ".param.obj.tmpAbC123").string(), std::string("v 0 0 0\n"));
   for (int delay_ms : {300, 1500}) {
     SCOPED_TRACE("delay " + std::to_string(delay_ms) + " ms");
     const RunOutcome r = run_and_signal(out, SIGTERM, std::chrono::milliseconds(delay_ms));

@@ -74,6 +74,8 @@ inline bool warn_about_released_constraints(const CrossField& field, const std::
 template <typename Body>
 int with_report(const std::string& out_dir, Body&& body) {
   std::filesystem::create_directories(out_dir);
+  // Temporary files of an earlier run that was killed outright (SIGKILL, power loss).
+  remove_atomic_write_leftovers(out_dir);
   const std::string report_path = (std::filesystem::path(out_dir) / "report.json").string();
   nlohmann::json report;
   std::optional<CancelWatchdog> watchdog(std::in_place, out_dir);

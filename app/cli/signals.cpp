@@ -120,6 +120,9 @@ void CancelWatchdog::watch() {
                       report.dump(2) + "\n");
   } catch (...) {
   }
+  // The main thread may be inside a write: its temporary file goes, and it cannot start
+  // another one before the exit below.
+  stop_atomic_writes_for_exit();
   remove_atomic_write_leftovers(out_dir_);
   std::cerr << "error: cancelled (" << signal_name(signo) << ")" << std::endl;
   std::_Exit(128 + signo);

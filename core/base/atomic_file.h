@@ -14,6 +14,13 @@ void write_file_atomic(const std::string& path, const std::string& content);
 //! Same, with a writer callback that streams into the temporary file.
 void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& writer);
 
+//! For a thread that is about to end the process (std::_Exit) while another thread may be
+//! writing: removes the temporary files of the writes in progress, and from then on every
+//! write_file_atomic call in any thread waits forever instead of creating or renaming a file.
+//! Targets keep their old or complete new content and no temporary file is left behind.
+//! \return the number of temporary files removed.
+int stop_atomic_writes_for_exit();
+
 //! Reads a whole file. \throw InvalidInputError naming the path when it cannot be read.
 std::string read_file(const std::string& path);
 
