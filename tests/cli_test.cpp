@@ -521,7 +521,7 @@ TEST(Cli, InfeasibleOrientationNamesTheNodesWhereTheLayoutFolds) {
             sectors + " --mesh " + mesh_file + " --layout " + layout_file + " --out " + dir),
         &out);
   };
-  ASSERT_EQ(run_star("--orientation-sectors field", out_dir), 0) << out;
+  ASSERT_EQ(run_star("--orientation-sectors field --no-untangle", out_dir), 0) << out;
   const auto report = read_json(out_dir + "/report.json");
   const auto& orientation = report["fold_removal"]["orientation"];
   ASSERT_TRUE(orientation["ran"].get<bool>());
@@ -544,6 +544,25 @@ TEST(Cli, InfeasibleOrientationNamesTheNodesWhereTheLayoutFolds) {
   EXPECT_NE(out.find(expected), std::string::npos) << out;
   EXPECT_NE(out.find("most violated at face"), std::string::npos) << out;
   EXPECT_EQ(orientation["sector_frame"].get<std::string>(), "field");
+  EXPECT_FALSE(orientation["untangle"]["ran"].get<bool>());
+
+  // The same with the untangling (the default): it starts where the infeasible QP left the
+  // map, keeps the exact constraints and leaves fewer fold-overs; the report says so.
+  const std::string untangled_dir = test::temp_dir("cli_orientation_untangled");
+  ASSERT_EQ(run_star("--orientation-sectors field", untangled_dir), 0) << out;
+  const auto untangled = read_json(untangled_dir + "/report.json");
+  const auto& ut = untangled["fold_removal"]["orientation"];
+  std::printf("[stat] mask star, field sectors, untangled: %d -> %d fold-overs, %s\n",
+              untangled["fold_removal"]["foldovers_before"].get<int>(),
+              untangled["metrics"]["foldovers"].get<int>(),
+              ut["message"].get<std::string>().c_str());
+  EXPECT_TRUE(ut["untangle"]["ran"].get<bool>());
+  EXPECT_GT(ut["untangle"]["newton_steps"].get<int>(), 0);
+  EXPECT_LT(untangled["metrics"]["foldovers"].get<int>(), left);
+  EXPECT_EQ(ut["untangle"]["foldovers_after"].get<int>(),
+            untangled["metrics"]["foldovers"].get<int>());
+  EXPECT_TRUE(ut["success"].get<bool>());
+  EXPECT_NE(ut["message"].get<std::string>().find("untangling: "), std::string::npos);
 
   // The default (auto): the field frame's sectors fail as above, the solution frame's unfold
   // every face, and that result is kept and named.
@@ -560,6 +579,8 @@ TEST(Cli, InfeasibleOrientationNamesTheNodesWhereTheLayoutFolds) {
   EXPECT_LT(auto_report["metrics"]["foldovers"].get<int>(), left);
   EXPECT_NE(auto_orientation["message"].get<std::string>().find("field-frame sectors: "),
             std::string::npos);
+  EXPECT_FALSE(auto_orientation["untangle"]["ran"].get<bool>())
+      << "no fold-over left for the untangling";
   EXPECT_EQ(run_star("--orientation-sectors sideways", auto_dir), 1)
       << "a usage error, like every malformed option: " << out;
   EXPECT_NE(out.find("--orientation-sectors"), std::string::npos) << out;

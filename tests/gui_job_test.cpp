@@ -182,13 +182,20 @@ TEST(GuiJob, WrapFreeHolesReachesTheField) {
 // A Run that ends with fold-overs says so and offers what `quadsketch-cli optimize` retries
 // with by itself: keeping the nodes apart and the sizing field, each only while it is off. The
 // case: the flat square whose free hole the field wraps ("Wrap free holes"), which folds
-// wherever the nodes go.
+// wherever the nodes go, unless the untangling runs (it unfolds it at E ≈ 358: off here).
 TEST(GuiJob, RunEndingWithFoldOversOffersTheRetries) {
   const test::MeshAndLayout sq = test::flat_square_with_free_hole();
   const Example ex{std::make_shared<const TriMesh>(sq.mesh), sq.layout};
   WorkerOptions options;
   options.align = false;
   options.wrap_free_holes = true;
+  {
+    const auto untangled = test::run_job(ex, options);
+    ASSERT_EQ(untangled->status, WorkerStatus::Finished) << untangled->message;
+    EXPECT_EQ(untangled->metrics.foldovers, 0) << untangled->message;
+    EXPECT_EQ(untangled->message.find("turn on"), std::string::npos) << untangled->message;
+  }
+  options.untangle = false;
   ASSERT_TRUE(options.node_optimization);
   ASSERT_FALSE(options.sizing);
   ASSERT_FALSE(options.keep_nodes_apart);

@@ -9,6 +9,7 @@
 // optimizations and the pig's solve, about a minute and a half in a Release build).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -201,8 +202,10 @@ TEST(OrientationDisplaced, InitialStateIsTheLastFallback) {
 // rounding when λ/s grows large. On the displaced pig (`import-quads --refine 3`, `perturb
 // --rings 2 --seed 1`) with fixed nodes and field-frame sectors the 24th factorization failed
 // at λ/s ≈ 9e9 and the attempt ended with "matrix is not positive definite". With the clamp of
-// λ/s lowered there the method goes on and finds what the problem is: infeasible.
-TEST(OrientationDisplaced, IllConditionedNormalMatrixIsNoError) {
+// λ/s lowered there the method goes on and finds what the problem is: infeasible. The
+// tri-sector constraints are only sufficient, though: the untangling that follows
+// (untangle.h) unfolds every face of the same layout, with the same constraints.
+TEST(OrientationDisplaced, IllConditionedNormalMatrixIsNoErrorAndUntanglingUnfolds) {
   const std::string dir = test::shared_meshes_dir();
   if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
   QuadImportOptions io;
@@ -227,6 +230,16 @@ TEST(OrientationDisplaced, IllConditionedNormalMatrixIsNoError) {
   EXPECT_EQ(r.message.find("not positive definite"), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("infeasible"), std::string::npos) << r.message;
   EXPECT_FALSE(r.infeasible_faces.empty());
+  std::printf("[stat] untangling: %d -> %d fold-overs, %d Newton steps, %d rounds, %.1f s\n",
+              r.untangle.foldovers_before, r.untangle.foldovers_after, r.untangle.newton_steps,
+              r.untangle.rounds, r.untangle.time_s);
+  EXPECT_TRUE(r.untangle.ran);
+  EXPECT_EQ(r.untangle.foldovers_before, r.foldovers_before);
+  EXPECT_EQ(r.untangle.foldovers_after, 0);
+  EXPECT_TRUE(r.success);
+  EXPECT_EQ(r.foldovers_after, 0);
+  EXPECT_EQ(p.foldovers, 0);
+  EXPECT_TRUE(std::isfinite(p.energy));
 }
 
 }  // namespace

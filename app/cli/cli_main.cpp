@@ -140,6 +140,11 @@ int main(int argc, char** argv) {
                    "45 deg, keeping the result with fewer fold-overs), field or solution")
       ->check(CLI::IsMember({"auto", "field", "solution"}))
       ->capture_default_str();
+  cmd_opt->add_flag("--no-untangle", opt.no_untangle,
+                    "Where the orientation constraints leave fold-overs (they are only "
+                    "sufficient), do not untangle the parameterization (a barrier on the "
+                    "faces' Jacobian determinants, Newton steps with the same exact "
+                    "constraints)");
   cmd_opt->add_flag("--no-orientation", opt.no_orientation,
                     "No orientation constraints against fold-overs after the node optimization "
                     "(stiffening only)");

@@ -54,7 +54,14 @@ nlohmann::json orientation_json(const OrientationReport& r) {
           {"time_s", r.time_s},
           {"sector_frame", r.sector_frame == SectorFrame::kSolution ? "solution" : "field"},
           {"message", r.message},
-          {"infeasible_faces", r.infeasible_faces}};
+          {"infeasible_faces", r.infeasible_faces},
+          {"untangle",
+           {{"ran", r.untangle.ran},
+            {"foldovers_before", r.untangle.foldovers_before},
+            {"foldovers_after", r.untangle.foldovers_after},
+            {"newton_steps", r.untangle.newton_steps},
+            {"rounds", r.untangle.rounds},
+            {"time_s", r.untangle.time_s}}}};
 }
 
 // When fold-overs remain (\p foldovers_left) after orientation constraints that were
@@ -62,7 +69,7 @@ nlohmann::json orientation_json(const OrientationReport& r) {
 // constraints could not unfold: where to look at (or edit) the layout.
 void warn_about_infeasible_orientation(const OrientationReport& r, int foldovers_left,
                                        const TriMesh& mesh, const Layout& layout) {
-  if (foldovers_left <= 0 || !r.ran || r.success || r.infeasible_faces.empty()) return;
+  if (foldovers_left <= 0 || !r.ran || r.infeasible_faces.empty()) return;
   const std::vector<int> near = nodes_near_faces(mesh, layout, r.infeasible_faces);
   std::cerr << "warning: " << foldovers_left << " fold-over(s) remain";
   if (!near.empty())
@@ -140,6 +147,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       no.gradient = o.gradient == "exact" ? GradientMethod::Exact : GradientMethod::Estimator;
       no.orientation_at_end = !o.no_orientation;
       no.orientation.sector_frame = sector_frame;
+      no.orientation.untangle = !o.no_untangle;
       no.slide_on_curves = !o.no_sliding;
       no.sharp_edges_as_curves = o.keep_sharp_edges;
       no.keep_nodes_apart = apart;
@@ -175,6 +183,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     if (o.orientation) {
       options.param.orientation.enabled = true;
       options.param.orientation.sector_frame = sector_frame;
+      options.param.orientation.untangle = !o.no_untangle;
       options.param.orientation.observer = &printer;
     }
     // Node optimization, then the retries below when it fails.

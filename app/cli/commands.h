@@ -41,6 +41,7 @@ struct OptimizeOptions {
   //! Sectors of the orientation constraints: "auto" (field frame, then the solution's where
   //! fold-overs remain), "field" or "solution" (OrientationOptions::sector_frame).
   std::string orientation_sectors = "auto";
+  bool no_untangle = false;       //!< OrientationOptions::untangle off
   bool no_sliding = false;        //!< nodes on curves stay (NodeOptOptions::slide_on_curves off)
   bool keep_sharp_edges = false;  //!< NodeOptOptions::sharp_edges_as_curves
   //! NodeOptOptions::keep_nodes_apart; unset: off, with a retry with it when the fold-over

@@ -438,6 +438,12 @@ void App::draw_pipeline_options() {
         "No node moves onto a vertex next to another node (no two nodes on one triangle): for "
         "dense layouts with a few edges per patch side, where crowded nodes keep fold-overs "
         "(--keep-nodes-apart)");
+  ImGui::Checkbox("Untangle fold-overs", &o.untangle);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip(
+        "Where the orientation constraints leave fold-overs, untangle the parameterization: a "
+        "barrier on each triangle's area, with the same layout constraints (off: "
+        "--no-untangle)");
   ImGui::Checkbox("Separate crowded nodes", &o.separate_nodes);
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip(
@@ -478,6 +484,7 @@ void App::draw_pipeline_options() {
     o.keep_sharp_edges = defaults.keep_sharp_edges;
     o.keep_nodes_apart = defaults.keep_nodes_apart;
     o.separate_nodes = defaults.separate_nodes;
+    o.untangle = defaults.untangle;
     o.remove_foldovers = defaults.remove_foldovers;
     o.alpha = defaults.alpha;
   }

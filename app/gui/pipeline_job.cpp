@@ -77,6 +77,7 @@ PipelineOptions pipeline_options(const WorkerOptions& o) {
   if (o.wrap_free_holes) options.field.free_loops = FreeLoopTurning::kWrap;
   options.param.anisotropy = o.anisotropy;
   options.param.sizing.enabled = o.sizing;
+  options.param.orientation.untangle = o.untangle;
   return options;
 }
 
@@ -218,6 +219,7 @@ NodeOptOptions editor_node_options(const WorkerOptions& o) {
   no.sharp_edges_as_curves = o.keep_sharp_edges;
   no.keep_nodes_apart = o.keep_nodes_apart;
   no.separate_crowded_nodes = o.separate_nodes;
+  no.orientation.untangle = o.untangle;
   no.stiffen_at_end = false;
   return no;
 }

@@ -71,6 +71,7 @@
 #include "core/mesh/geometry.h"
 #include "core/mesh/mesh.h"
 #include "core/param/constraints.h"
+#include "core/param/untangle.h"
 
 namespace qs {
 
@@ -119,6 +120,12 @@ struct OrientationOptions {
   //! asks to cancel): one solve can run for seconds on large models (the 70K bunny: 11 s in
   //! 3 rounds). Not owned; must outlive the solve; nullptr: never cancelled.
   const Observer* observer = nullptr;
+  //! Where fold-overs remain after the QP (or it is infeasible), minimize the untangling
+  //! energy of untangle.h from the better of the two solutions; kept when it has fewer
+  //! fold-overs. The tri-sector constraints are only sufficient for orientation, so a map they
+  //! cannot reach may still unfold.
+  bool untangle = true;
+  UntangleOptions untangle_options;  //!< its observer is \ref observer
 };
 
 struct OrientationReport {
@@ -146,6 +153,7 @@ struct OrientationReport {
   //! When the last round was infeasible: the constrained faces its last iterate violates most
   //! (at most 5, worst first; also named in \ref message), where the layout cannot unfold.
   std::vector<int> infeasible_faces;
+  UntangleReport untangle;  //!< the untangling after the QP (OrientationOptions::untangle)
 };
 
 //! Per-face ideal corner offsets Q_k (see above) in the field frame, [f][k] = (u, v), length

@@ -625,6 +625,25 @@ const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCa
     } catch (const SolverError& e) {
       rep.message = e.what();
     }
+    const int folds = rep.success ? rep.foldovers_after : rep.foldovers_before;
+    if (options_.orientation.untangle && folds > 0) {
+      UntangleOptions uo = options_.orientation.untangle_options;
+      uo.observer = options_.orientation.observer;
+      const Eigen::VectorXd yu =
+          untangle(g, cut_.corner_wedge, reduction_, A, b, y, uo, &rep.untangle);
+      rep.time_s += rep.untangle.time_s;
+      if (rep.untangle.foldovers_after < folds) {
+        if (!rep.success) rep.energy_before = energy_of(y);
+        y = yu;
+        rep.success = true;
+        rep.foldovers_after = rep.untangle.foldovers_after;
+        rep.energy_after = energy_of(yu);
+      }
+      rep.message += (rep.message.empty() ? "" : "; ") + std::string("untangling: ") +
+                     std::to_string(folds) + " -> " + std::to_string(rep.untangle.foldovers_after) +
+                     " fold-over(s) in " + std::to_string(rep.untangle.newton_steps) +
+                     " Newton step(s)";
+    }
   }
   const Eigen::VectorXd x = Z * y + reduction_.z0;
   result_.energy = std::max(0.0, x.dot(H * x) - 2 * rhs.dot(x) + constant);  // energy_of(y)

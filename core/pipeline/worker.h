@@ -62,6 +62,9 @@ struct WorkerOptions {
   //! orientation constraints (`optimize --no-node-opt --orientation`); the node optimization
   //! removes fold-overs at its end in any case.
   bool remove_foldovers = false;
+  //! Where the orientation constraints leave fold-overs, untangle the parameterization
+  //! (OrientationOptions::untangle; --no-untangle turns it off).
+  bool untangle = true;
 };
 
 //! What a step function sees of the job: a qs::Observer, so it can be handed straight to
