@@ -1227,6 +1227,43 @@ TEST(NodeOptimizer, ParallelRetryGivesTheSequentialTrajectory) {
   expect_same_layout(a.layout, b.layout);
 }
 
+// The untangling is the last resort of the fold-over removal: orientation constraints with one
+// interior-point iteration leave fold-overs at every state tried (the premise, checked with the
+// untangling off); with it on, the state returned is untangled to fewer fold-overs, with the
+// same node positions, and the result says so.
+TEST(NodeOptimizer, UntanglingIsTheLastResort) {
+  const auto in = test::cube_sphere(8, Vec3(1.3, 1, 0.75));
+  const Layout start = test::displace_nodes(in.mesh, in.layout, 4, 6);
+  NodeOptOptions no;
+  no.max_steps = 3;
+  no.hop_descent_steps = 0;
+  no.max_hop_rounds = 1;
+  no.orientation.max_iterations = 1;
+  no.stiffen_at_end = false;
+  no.orientation.untangle = false;
+  const NodeOptResult plain = optimize_nodes(in.mesh, start, PipelineOptions{}, no);
+  ASSERT_GT(plain.foldovers_final, 0) << "the case must keep fold-overs without the untangling";
+  EXPECT_FALSE(plain.untangled);
+  no.orientation.untangle = true;
+  const NodeOptResult untangled = optimize_nodes(in.mesh, start, PipelineOptions{}, no);
+  std::printf("[stat] cube-sphere seed 6: %d fold-overs left, untangled %d (E %.6g -> %.6g)\n",
+              plain.foldovers_final, untangled.foldovers_final, plain.E_final, untangled.E_final);
+  EXPECT_TRUE(untangled.untangled);
+  EXPECT_LT(untangled.foldovers_final, plain.foldovers_final);
+  EXPECT_EQ(untangled.foldovers_final, 0);
+  EXPECT_TRUE(untangled.orientation.untangle.ran);
+  EXPECT_TRUE(untangled.orientation_constraints);
+  EXPECT_TRUE(untangled.orientation_options.untangle);
+  ASSERT_TRUE(untangled.pipeline && untangled.pipeline->parameterization());
+  EXPECT_EQ(untangled.pipeline->parameterization()->foldovers, untangled.foldovers_final);
+  // The same state as without the untangling: it only changes the last solve.
+  expect_same_layout(plain.layout, untangled.layout);
+  ASSERT_FALSE(untangled.reports.empty());
+  EXPECT_EQ(untangled.reports.back().phase, "orientation");
+  EXPECT_TRUE(untangled.reports.back().accepted);
+  EXPECT_EQ(untangled.reports.back().foldovers, untangled.foldovers_final);
+}
+
 // parallel_fallback solves the state before the polish beside the final state's fold-over
 // removal: the result, the reports streamed to the observer and their order are those of the
 // sequential order. Orientation with one interior-point iteration leaves fold-overs at the final

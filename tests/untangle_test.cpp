@@ -106,8 +106,7 @@ TEST(Untangle, FoldedGridWithFixedBoundaryUnfolds) {
   const Eigen::VectorXd out =
       untangle(p.geometry, p.corner_wedge, p.reduction, p.A, p.b, y, UntangleOptions{}, &rep);
   std::printf("[stat] untangle: %d -> %d fold-overs, %d Newton steps, %d rounds, eps %.3g\n",
-              rep.foldovers_before, rep.foldovers_after, rep.newton_steps, rep.rounds,
-              rep.epsilon);
+              rep.foldovers_before, rep.foldovers_after, rep.newton_steps, rep.rounds, rep.epsilon);
   EXPECT_TRUE(rep.ran);
   EXPECT_EQ(rep.foldovers_before, folds_before);
   EXPECT_EQ(rep.foldovers_after, 0);

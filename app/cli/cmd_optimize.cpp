@@ -202,6 +202,12 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       const auto fell_back = [](const NodeOptResult& r) {
         return r.fewest_foldovers_reverted || r.initial_reverted;
       };
+      // Fold-overs left, or removed only by the untangling (the orientation constraints failed at
+      // every state tried): the untangled map keeps its state's parametric cones, so a retry
+      // that embeds through the constraints is preferred at equal fold-overs.
+      const auto unembedded = [](const NodeOptResult& r) {
+        return r.foldovers_final > 0 || r.untangled;
+      };
       // One retry from the input with \p run_options and \p apart (\p with names it, \p flags
       // the options that decide it up front). The retry's run is adopted when \p better(retry,
       // first) says so (`used` in the report entry, to which the caller adds its own fields).
@@ -217,6 +223,8 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
           std::cerr << "optimize: ";
           if (first.foldovers_final > 0)
             std::cerr << first.foldovers_final << " fold-over(s) remain";
+          else if (first.untangled)
+            std::cerr << "only the untangling removed the fold-overs";
           else if (first.initial_reverted)
             std::cerr << "the fold-over removal fell back to the initial state";
           else
@@ -231,6 +239,8 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
                                 {"E_final_without", first.E_final},
                                 {"foldovers_with", second.foldovers_final},
                                 {"E_final_with", second.E_final},
+                                {"untangled_without", first.untangled},
+                                {"untangled_with", second.untangled},
                                 {"used", used}};
         if (!common.quiet)
           std::cerr << "optimize: with " << with << " " << second.foldovers_final
@@ -250,14 +260,16 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       // initial state, E 2.048; kept apart, E 1.578 and no fold-overs). Not the default itself:
       // crowded starts (the displaced spot) then keep fold-overs the default removes.
       if (may_retry_apart && !node_result->stopped &&
-          (node_result->foldovers_final > 0 || fell_back(*node_result))) {
+          (unembedded(*node_result) || fell_back(*node_result))) {
         const bool fell_back_without = fell_back(*node_result);
-        Retry r = retry(
-            "nodes kept apart", "--keep-nodes-apart or --no-keep-nodes-apart", input_options, true,
-            [](const NodeOptResult& run, const NodeOptResult& first) {
-              return run.foldovers_final < first.foldovers_final ||
-                     (run.foldovers_final == first.foldovers_final && run.E_final < first.E_final);
-            });
+        Retry r =
+            retry("nodes kept apart", "--keep-nodes-apart or --no-keep-nodes-apart", input_options,
+                  true, [](const NodeOptResult& run, const NodeOptResult& first) {
+                    if (run.foldovers_final != first.foldovers_final)
+                      return run.foldovers_final < first.foldovers_final;
+                    if (run.untangled != first.untangled) return !run.untangled;
+                    return run.E_final < first.E_final;
+                  });
         apart_retry = std::move(r.entry);
         apart_retry["fell_back_without"] = fell_back_without;
         if (r.used) {
@@ -276,7 +288,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       // --no-sizing decides up front; --no-orientation (stiffening only, an ablation) and the
       // discrete baseline are run as asked.
       if (may_retry && !node_result->stopped &&
-          (node_result->foldovers_final > 0 || node_result->initial_reverted)) {
+          (unembedded(*node_result) || node_result->initial_reverted)) {
         PipelineOptions sized = input_options;
         sized.param.sizing.enabled = true;
         const bool initial_without = node_result->initial_reverted;
@@ -284,7 +296,8 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
                         [](const NodeOptResult& run, const NodeOptResult& first) {
                           return run.foldovers_final < first.foldovers_final ||
                                  (run.foldovers_final == first.foldovers_final &&
-                                  first.initial_reverted && !run.initial_reverted);
+                                  ((first.initial_reverted && !run.initial_reverted) ||
+                                   (first.untangled && !run.untangled)));
                         });
         sizing_retry = std::move(r.entry);
         sizing_retry["initial_without"] = initial_without;
@@ -400,6 +413,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
           {"polish_reverted", node_result->polish_reverted},
           {"fewest_foldovers_reverted", node_result->fewest_foldovers_reverted},
           {"initial_reverted", node_result->initial_reverted},
+          {"untangled", node_result->untangled},
           {"keep_nodes_apart", keep_apart},
           {"crowded_nodes", node_result->crowded_nodes},
           {"separated_nodes", node_result->separated_nodes}};

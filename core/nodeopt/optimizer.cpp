@@ -1126,6 +1126,8 @@ struct NodeOptimizer::Impl {
         oriented.param.orientation = no.orientation;
         oriented.param.orientation.enabled = true;
         oriented.param.orientation.observer = obs;  // polled inside the solve (seconds long)
+        // Untangling is the last resort, after every state was tried (below).
+        oriented.param.orientation.untangle = false;
         if (fallback) oriented.param.orientation.stop_if_all_faces_infeasible = true;
         try {
           auto p = std::make_shared<Pipeline>(st_in.mesh, st_in.layout, oriented);
@@ -1264,6 +1266,50 @@ struct NodeOptimizer::Impl {
                                           : result.polish_reverted && pre_polish_is_initial);
     if (has_earlier && no.stiffen_at_end && result.foldovers_final > 0)
       stiffen_into(state, result.descent_pipeline, result);
+    // The last resort: the untangling (untangle.h) at the state returned, when the tri-sector
+    // constraints left fold-overs at every state tried and stiffening did too. Not inside those
+    // attempts: an untangled map has no fold-over but keeps the parametric cones of its state,
+    // and the constraints' failure at a state often marks wrong cones that an earlier state does
+    // not have (the rocker-arm cage layout: untangled at its final state, 0 fold-overs and 7 bad
+    // cones; its fewest-fold-over state embeds structurally equivalent).
+    if (no.orientation_at_end && no.orientation.untangle && result.foldovers_final > 0) {
+      const auto t_un = std::chrono::steady_clock::now();
+      check_cancel(observer);
+      PipelineOptions oriented = options;
+      oriented.param.orientation = no.orientation;
+      oriented.param.orientation.enabled = true;
+      oriented.param.orientation.observer = observer;
+      try {
+        auto p = std::make_shared<Pipeline>(state.mesh, state.layout, oriented);
+        p->compute_field();
+        const Parameterization& par = p->compute_parameterization();
+        if (par.orientation.success && par.foldovers < result.foldovers_final) {
+          result.orientation = par.orientation;
+          result.orientation_constraints = true;
+          result.orientation_options = oriented.param.orientation;
+          result.orientation_options.observer = nullptr;  // not valid after this call
+          result.face_weights.clear();
+          result.E_final =
+              unweighted_energy(p->mesh(), p->geometry(), p->field()->theta, par, options.param);
+          result.foldovers_final = par.foldovers;
+          result.pipeline = std::move(p);
+          result.untangled = true;
+        }
+      } catch (const Cancelled&) {
+        throw;
+      } catch (const QsError& e) {
+        result.orientation.message +=
+            std::string(result.orientation.message.empty() ? "" : "; ") + "untangling: " + e.what();
+      }
+      StepReport r;
+      r.step = result.steps + result.hop_rounds + 1;
+      r.E = result.E_final;
+      r.accepted = result.untangled;
+      r.foldovers = result.foldovers_final;
+      r.time_s = seconds_since(t_un);
+      r.phase = "orientation";
+      emit_step(r, state.mesh, state.layout, result.reports, observer);
+    }
     if (stats) *stats = counters;
     result.mesh = std::move(state.mesh);
     result.layout = std::move(state.layout);

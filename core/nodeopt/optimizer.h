@@ -263,6 +263,10 @@ struct NodeOptResult {
   //! one before the polish, or NodeOptOptions::initial_fallback): the node movement was given
   //! up.
   bool initial_reverted = false;
+  //! The returned state's fold-overs were removed by the untangling (OrientationOptions::
+  //! untangle), the last resort after the orientation constraints at every state tried and
+  //! stiffening left some.
+  bool untangled = false;
   int stiffening_iterations = 0;
   //! NodeOptOptions::stop (or DiscreteOptions::stop) ended the node movement before the
   //! descent and polish (the discrete sweeps) were over.
