@@ -1102,6 +1102,37 @@ struct NodeOptimizer::Impl {
     // fold-overs in 5.6 s), while the orientation solve at an earlier state often succeeds.
     const bool try_fewest = fewest_folds && fewest_folds_count < current.foldovers;
     const bool has_earlier = no.orientation_at_end && (pre_polish || try_fewest);
+    // One orientation-constrained solve of \p st (\p untangle: OrientationOptions::untangle;
+    // \p fallback: as remove_foldovers'), polled by \p obs; its options, without the observer,
+    // into \p used.
+    auto oriented_solve = [&](const State& st, bool untangle, bool fallback, Observer* obs,
+                              OrientationOptions& used) {
+      PipelineOptions oriented = options;
+      oriented.param.orientation = no.orientation;
+      oriented.param.orientation.enabled = true;
+      oriented.param.orientation.observer = obs;  // polled inside the solve (seconds long)
+      oriented.param.orientation.untangle = untangle;
+      if (fallback) oriented.param.orientation.stop_if_all_faces_infeasible = true;
+      auto p = std::make_shared<Pipeline>(st.mesh, st.layout, oriented);
+      p->compute_field();
+      p->compute_parameterization();
+      used = oriented.param.orientation;
+      used.observer = nullptr;  // not valid after this call
+      return p;
+    };
+    // Reports a fold-over removal solve begun at \p t as an "orientation" step.
+    auto emit_orientation = [&](const State& st, const NodeOptResult& out, bool accepted,
+                                std::chrono::steady_clock::time_point t,
+                                std::vector<StepReport>& reports, Observer* obs) {
+      StepReport r;
+      r.step = result.steps + result.hop_rounds + 1;
+      r.E = out.E_final;
+      r.accepted = accepted;
+      r.foldovers = out.foldovers_final;
+      r.time_s = seconds_since(t);
+      r.phase = "orientation";
+      emit_step(r, st.mesh, st.layout, reports, obs);
+    };
     // The end of the descent at (state, current): fold-over removal, results into `out`.
     // \p fallback: an earlier state will be tried when fold-overs remain here, so an infeasible
     // all-faces orientation round ends this attempt.
@@ -1122,22 +1153,15 @@ struct NodeOptimizer::Impl {
       if (no.orientation_at_end && ev.foldovers > 0) {
         const auto t_or = std::chrono::steady_clock::now();
         check_cancel(obs);
-        PipelineOptions oriented = options;
-        oriented.param.orientation = no.orientation;
-        oriented.param.orientation.enabled = true;
-        oriented.param.orientation.observer = obs;  // polled inside the solve (seconds long)
-        // Untangling is the last resort, after every state was tried (below).
-        oriented.param.orientation.untangle = false;
-        if (fallback) oriented.param.orientation.stop_if_all_faces_infeasible = true;
         try {
-          auto p = std::make_shared<Pipeline>(st_in.mesh, st_in.layout, oriented);
-          p->compute_field();
-          const Parameterization& par = p->compute_parameterization();
+          // Untangling is the last resort, after every state was tried (below).
+          OrientationOptions used;
+          auto p = oriented_solve(st_in, false, fallback, obs, used);
+          const Parameterization& par = *p->parameterization();
           out.orientation = par.orientation;
           if (par.orientation.success && par.foldovers < ev.foldovers) {
             out.orientation_constraints = true;
-            out.orientation_options = oriented.param.orientation;
-            out.orientation_options.observer = nullptr;  // not valid after this call
+            out.orientation_options = used;
             out.E_final =
                 unweighted_energy(p->mesh(), p->geometry(), p->field()->theta, par, options.param);
             out.foldovers_final = par.foldovers;
@@ -1148,14 +1172,7 @@ struct NodeOptimizer::Impl {
         } catch (const QsError& e) {
           out.orientation.message = e.what();
         }
-        StepReport r;
-        r.step = result.steps + result.hop_rounds + 1;
-        r.E = out.E_final;
-        r.accepted = out.orientation_constraints;
-        r.foldovers = out.foldovers_final;
-        r.time_s = seconds_since(t_or);
-        r.phase = "orientation";
-        emit_step(r, st_in.mesh, st_in.layout, out.reports, obs);
+        emit_orientation(st_in, out, out.orientation_constraints, t_or, out.reports, obs);
       }
       if (stiffen && no.stiffen_at_end && out.foldovers_final > 0)
         stiffen_into(st_in, ev.pipeline, out);
@@ -1275,19 +1292,15 @@ struct NodeOptimizer::Impl {
     if (no.orientation_at_end && no.orientation.untangle && result.foldovers_final > 0) {
       const auto t_un = std::chrono::steady_clock::now();
       check_cancel(observer);
-      PipelineOptions oriented = options;
-      oriented.param.orientation = no.orientation;
-      oriented.param.orientation.enabled = true;
-      oriented.param.orientation.observer = observer;
       try {
-        auto p = std::make_shared<Pipeline>(state.mesh, state.layout, oriented);
-        p->compute_field();
-        const Parameterization& par = p->compute_parameterization();
+        OrientationOptions used;
+        auto p = oriented_solve(state, true, false, observer, used);
+        const Parameterization& par = *p->parameterization();
+        result.orientation.untangle = par.orientation.untangle;  // reported in any case
         if (par.orientation.success && par.foldovers < result.foldovers_final) {
           result.orientation = par.orientation;
           result.orientation_constraints = true;
-          result.orientation_options = oriented.param.orientation;
-          result.orientation_options.observer = nullptr;  // not valid after this call
+          result.orientation_options = used;
           result.face_weights.clear();
           result.E_final =
               unweighted_energy(p->mesh(), p->geometry(), p->field()->theta, par, options.param);
@@ -1301,14 +1314,7 @@ struct NodeOptimizer::Impl {
         result.orientation.message +=
             std::string(result.orientation.message.empty() ? "" : "; ") + "untangling: " + e.what();
       }
-      StepReport r;
-      r.step = result.steps + result.hop_rounds + 1;
-      r.E = result.E_final;
-      r.accepted = result.untangled;
-      r.foldovers = result.foldovers_final;
-      r.time_s = seconds_since(t_un);
-      r.phase = "orientation";
-      emit_step(r, state.mesh, state.layout, result.reports, observer);
+      emit_orientation(state, result, result.untangled, t_un, result.reports, observer);
     }
     if (stats) *stats = counters;
     result.mesh = std::move(state.mesh);
