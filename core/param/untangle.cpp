@@ -120,6 +120,10 @@ FaceJacobians face_jacobians(const GeometryCache& g, const std::vector<int>& cor
   return fj;
 }
 
+double det_of(const Vec4& J) {
+  return J(0) * J(3) - J(1) * J(2);
+}
+
 Vec4 jacobian_of(const FaceJacobians& fj, int f, const Eigen::VectorXd& y) {
   Vec4 J = fj.j0[f];
   for (int i = fj.offset[f]; i < fj.offset[f + 1]; ++i)
@@ -195,8 +199,7 @@ Eigen::VectorXd untangle(const GeometryCache& g, const std::vector<int>& corner_
   std::vector<double> dets;
   for (int f = 0; f < g.n_faces; ++f) {
     if (fj.area[f] <= 0) continue;
-    const Vec4 J = jacobian_of(fj, f, y_start);
-    const double D = J(0) * J(3) - J(1) * J(2);
+    const double D = det_of(jacobian_of(fj, f, y_start));
     if (D > 0) dets.push_back(D);
   }
   double det_scale = 1.0;
@@ -206,13 +209,20 @@ Eigen::VectorXd untangle(const GeometryCache& g, const std::vector<int>& corner_
   }
   const double lambda = o.area_weight;
   auto quadratic = [&](const Eigen::VectorXd& y) { return 0.5 * y.dot(A_full * y) - b.dot(y); };
+  // Σ_t a_t F_ε(J_t) (alone: σ of the ε rule) and the smallest determinant (when asked).
+  auto barrier_sum = [&](const Eigen::VectorXd& yy, double e, double* d_min = nullptr) {
+    double sum = 0;
+    if (d_min) *d_min = std::numeric_limits<double>::infinity();
+    for (int f = 0; f < g.n_faces; ++f) {
+      if (fj.area[f] <= 0) continue;
+      const Vec4 J = jacobian_of(fj, f, yy);
+      if (d_min) *d_min = std::min(*d_min, det_of(J));
+      sum += fj.area[f] * barrier(J, e, lambda, det_scale, nullptr, nullptr);
+    }
+    return sum;
+  };
   auto phi = [&](const Eigen::VectorXd& y, double eps) {
-    double s = mu * quadratic(y);
-    for (int f = 0; f < g.n_faces; ++f)
-      if (fj.area[f] > 0)
-        s += o.beta * fj.area[f] *
-             barrier(jacobian_of(fj, f, y), eps, lambda, det_scale, nullptr, nullptr);
-    return s;
+    return mu * quadratic(y) + o.beta * barrier_sum(y, eps);
   };
   auto foldovers = [&](const Eigen::VectorXd& y) {
     return count_foldovers(corner_wedge, red.Z * y + red.z0);
@@ -236,18 +246,6 @@ Eigen::VectorXd untangle(const GeometryCache& g, const std::vector<int>& corner_
   Mat4 H4;
   Vec4 g4;
   Eigen::MatrixXd Lf, Hf;
-  // The barrier term alone (σ of the ε rule) and the smallest determinant.
-  auto barrier_sum = [&](const Eigen::VectorXd& yy, double e, double* d_min) {
-    double sum = 0;
-    *d_min = std::numeric_limits<double>::infinity();
-    for (int f = 0; f < g.n_faces; ++f) {
-      if (fj.area[f] <= 0) continue;
-      const Vec4 J = jacobian_of(fj, f, yy);
-      *d_min = std::min(*d_min, J(0) * J(3) - J(1) * J(2));
-      sum += fj.area[f] * barrier(J, e, lambda, det_scale, nullptr, nullptr);
-    }
-    return sum;
-  };
   while (rep.newton_steps < o.max_newton) {
     ++rep.rounds;
     double d_min = 0;
