@@ -128,6 +128,34 @@ TEST(Untangle, FoldedGridWithFixedBoundaryUnfolds) {
   }
 }
 
+// The faces' terms are split in two halves that sum separately whether or not the second half
+// runs on another thread, so both settings give the same iterates, bit for bit.
+TEST(Untangle, SecondThreadGivesTheSameMap) {
+  const int n = 64;  // 8192 faces: the size from which the second thread is used
+  const GridProblem p = grid_problem(n);
+  ASSERT_GE(p.geometry.n_faces, 8000);
+  Eigen::VectorXd y = identity_y(p);
+  for (size_t i = 0; i < p.interior.size(); ++i)
+    if (y(2 * i) < n / 2) y(2 * i) = n - y(2 * i) + 0.3;
+  ASSERT_GT(count_foldovers(p.corner_wedge, p.reduction.Z * y + p.reduction.z0), 100);
+  UntangleOptions one, two;
+  one.second_thread = false;
+  two.second_thread = true;
+  UntangleReport rep_one, rep_two;
+  const Eigen::VectorXd a =
+      untangle(p.geometry, p.corner_wedge, p.reduction, p.A, p.b, y, one, &rep_one);
+  const Eigen::VectorXd b =
+      untangle(p.geometry, p.corner_wedge, p.reduction, p.A, p.b, y, two, &rep_two);
+  std::printf("[stat] untangle %d faces: %d -> %d fold-overs, %d Newton steps, %.3f s / %.3f s\n",
+              p.geometry.n_faces, rep_one.foldovers_before, rep_one.foldovers_after,
+              rep_one.newton_steps, rep_one.time_s, rep_two.time_s);
+  EXPECT_EQ(rep_one.foldovers_after, 0);
+  EXPECT_EQ(rep_one.newton_steps, rep_two.newton_steps);
+  EXPECT_EQ(rep_one.foldovers_after, rep_two.foldovers_after);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ((a - b).cwiseAbs().maxCoeff(), 0.0);
+}
+
 TEST(Untangle, FoldFreeStartIsReturnedAsItIs) {
   const GridProblem p = grid_problem(5);
   Eigen::VectorXd y = identity_y(p);

@@ -2,9 +2,12 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <limits>
+#include <thread>
 
 #include "core/base/errors.h"
 #include "core/base/spd_solver.h"
@@ -70,7 +73,10 @@ double barrier(const Vec4& J, double eps, double lambda, double D0, Vec4* grad, 
   return F;
 }
 
+// The nearest positive semidefinite matrix (eigenvalues clamped at 0); a positive definite H,
+// which a Cholesky factorization recognizes cheaply, is returned as it is.
 Mat4 project_psd(const Mat4& H) {
+  if (Eigen::LLT<Mat4>(H).info() == Eigen::Success) return H;
   Eigen::SelfAdjointEigenSolver<Mat4> es(H);
   Vec4 ev = es.eigenvalues();
   for (int i = 0; i < 4; ++i) ev(i) = std::max(ev(i), 0.0);
@@ -129,6 +135,20 @@ Vec4 jacobian_of(const FaceJacobians& fj, int f, const Eigen::VectorXd& y) {
   for (int i = fj.offset[f]; i < fj.offset[f + 1]; ++i)
     J += y(fj.cols[i]) * Eigen::Map<const Vec4>(&fj.L[4 * i]);
   return J;
+}
+
+// Runs body(begin, end) over [0, n) in two halves, the second on another thread when asked.
+template <class Body>
+void two_halves(int n, bool second_thread, const Body& body) {
+  const int mid = n / 2;
+  if (second_thread) {
+    auto second = std::async(std::launch::async, [&body, mid, n] { body(1, mid, n); });
+    body(0, 0, mid);
+    second.get();
+  } else {
+    body(0, 0, mid);
+    body(1, mid, n);
+  }
 }
 
 }  // namespace
@@ -208,18 +228,64 @@ Eigen::VectorXd untangle(const GeometryCache& g, const std::vector<int>& corner_
     det_scale = dets[dets.size() / 2];
   }
   const double lambda = o.area_weight;
+  const bool two_threads =
+      o.second_thread && g.n_faces >= 8000 && std::thread::hardware_concurrency() >= 2;
   auto quadratic = [&](const Eigen::VectorXd& y) { return 0.5 * y.dot(A_full * y) - b.dot(y); };
   // Σ_t a_t F_ε(J_t) (alone: σ of the ε rule) and the smallest determinant (when asked).
+  // Each half of the faces sums on its own; the halves are added in order, so the value does
+  // not depend on the thread count.
   auto barrier_sum = [&](const Eigen::VectorXd& yy, double e, double* d_min = nullptr) {
-    double sum = 0;
-    if (d_min) *d_min = std::numeric_limits<double>::infinity();
-    for (int f = 0; f < g.n_faces; ++f) {
-      if (fj.area[f] <= 0) continue;
-      const Vec4 J = jacobian_of(fj, f, yy);
-      if (d_min) *d_min = std::min(*d_min, det_of(J));
-      sum += fj.area[f] * barrier(J, e, lambda, det_scale, nullptr, nullptr);
-    }
-    return sum;
+    std::array<double, 2> sum{0, 0};
+    std::array<double, 2> lowest{std::numeric_limits<double>::infinity(),
+                                 std::numeric_limits<double>::infinity()};
+    two_halves(g.n_faces, two_threads, [&](int half, int begin, int end) {
+      for (int f = begin; f < end; ++f) {
+        if (fj.area[f] <= 0) continue;
+        const Vec4 J = jacobian_of(fj, f, yy);
+        lowest[half] = std::min(lowest[half], det_of(J));
+        sum[half] += fj.area[f] * barrier(J, e, lambda, det_scale, nullptr, nullptr);
+      }
+    });
+    if (d_min) *d_min = std::min(lowest[0], lowest[1]);
+    return sum[0] + sum[1];
+  };
+  // The faces' weighted gradients and projected Hessians, summed by each half of the faces into
+  // its own copy of the gradient and of M's values (no locks; the two copies are added after).
+  std::array<std::vector<double>, 2> part_grad, part_hess;
+  for (int h = 0; h < 2; ++h) {
+    part_grad[h].resize(n);
+    part_hess[h].resize(M.nonZeros());
+  }
+  auto face_terms = [&](const Eigen::VectorXd& yy, double e) {
+    two_halves(g.n_faces, two_threads, [&](int half, int begin, int end) {
+      double* gv = part_grad[half].data();
+      double* hv = part_hess[half].data();
+      std::fill(gv, gv + n, 0.0);
+      std::fill(hv, hv + M.nonZeros(), 0.0);
+      Mat4 H4;
+      Vec4 g4;
+      std::vector<Vec4> PL;  // P · (column j of the face's L)
+      for (int f = begin; f < end; ++f) {
+        if (fj.area[f] <= 0) continue;
+        const int k = fj.offset[f + 1] - fj.offset[f];
+        barrier(jacobian_of(fj, f, yy), e, lambda, det_scale, &g4, &H4);
+        const Mat4 P = project_psd(H4);
+        const double w = o.beta * fj.area[f];
+        const double* L = &fj.L[4 * fj.offset[f]];
+        const int* col = &fj.cols[fj.offset[f]];
+        PL.resize(k);
+        for (int j = 0; j < k; ++j) {
+          const Eigen::Map<const Vec4> Lj(L + 4 * j);
+          gv[col[j]] += w * Lj.dot(g4);
+          PL[j] = w * (P * Lj);
+        }
+        const int* slot = &fj.slot[fj.slot_offset[f]];
+        for (int i = 0; i < k; ++i) {
+          const Eigen::Map<const Vec4> Li(L + 4 * i);
+          for (int j = 0; j <= i; ++j) hv[*slot++] += Li.dot(PL[j]);
+        }
+      }
+    });
   };
   auto phi = [&](const Eigen::VectorXd& y, double eps) {
     return mu * quadratic(y) + o.beta * barrier_sum(y, eps);
@@ -243,9 +309,6 @@ Eigen::VectorXd untangle(const GeometryCache& g, const std::vector<int>& corner_
 
   SpdSolver solver("untangling");
   Eigen::VectorXd grad(n), step(n), trial(n);
-  Mat4 H4;
-  Vec4 g4;
-  Eigen::MatrixXd Lf, Hf;
   while (rep.newton_steps < o.max_newton) {
     ++rep.rounds;
     double d_min = 0;
@@ -255,23 +318,12 @@ Eigen::VectorXd untangle(const GeometryCache& g, const std::vector<int>& corner_
     for (int it = 0; it < o.newton_per_round && rep.newton_steps < o.max_newton; ++it) {
       check_cancel(o.observer);
       // Gradient and projected Hessian of Φ_ε.
-      std::fill(M.valuePtr(), M.valuePtr() + M.nonZeros(), 0.0);
+      face_terms(y, eps);
+      for (Eigen::Index s = 0; s < M.nonZeros(); ++s)
+        M.valuePtr()[s] = part_hess[0][s] + part_hess[1][s];
       for (const auto& [s, v] : a_slots) M.valuePtr()[s] += mu * v;
       grad = mu * (A_full * y - b);
-      for (int f = 0; f < g.n_faces; ++f) {
-        if (fj.area[f] <= 0) continue;
-        const int k = fj.offset[f + 1] - fj.offset[f];
-        const Vec4 J = jacobian_of(fj, f, y);
-        barrier(J, eps, lambda, det_scale, &g4, &H4);
-        const double w = o.beta * fj.area[f];
-        Lf = Eigen::Map<const Eigen::MatrixXd>(&fj.L[4 * fj.offset[f]], 4, k);
-        const Eigen::VectorXd gl = Lf.transpose() * g4;
-        for (int i = 0; i < k; ++i) grad(fj.cols[fj.offset[f] + i]) += w * gl(i);
-        Hf = Lf.transpose() * project_psd(H4) * Lf;
-        int s = fj.slot_offset[f];
-        for (int i = 0; i < k; ++i)
-          for (int j = 0; j <= i; ++j) M.valuePtr()[fj.slot[s++]] += w * Hf(i, j);
-      }
+      for (int c = 0; c < n; ++c) grad(c) += part_grad[0][c] + part_grad[1][c];
       // M is SPD in exact arithmetic (μA plus PSD blocks); when the barrier's curvature
       // outgrows A's by many orders, rounding can break that: shift the diagonal and retry.
       bool factorized = false;
