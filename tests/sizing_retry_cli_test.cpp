@@ -191,58 +191,9 @@ TEST_F(SizingRetry, DefaultRunTakesNodesKeptApartWhenItEndsLower) {
       retry["E_final_without"].get<double>(), retry["E_final_with"].get<double>());
 }
 
-// The sizing retry after a fallback to the initial state: spot's quad mesh imported onto its own
-// triangulation and displaced two rings (as scripts/bench.sh does), optimized with nodes kept
-// apart (given, so no keep-apart retry): the fold-over removal embeds only the initial state
-// (OrientationDisplaced.InitialStateIsTheLastFallback), so the run is repeated with the sizing
-// field, which embeds its moved layout, and that run is written although both end without
-// fold-overs (E is no criterion across the sizing field).
-TEST(SizingRetryAfterFallback, RunBackAtTheInitialStateTakesTheSizedRun) {
-  const std::string dir = test::shared_meshes_dir();
-  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";
-  const std::string out = test::temp_dir("cli_sizing_after_fallback");
-  std::string log;
-  ASSERT_EQ(test::run_command(test::cli_path() + " import-quads --quiet --quads " + dir +
-                                  "/spot/spot_quadrangulated.obj --out " + out + "/spot",
-                              &log),
-            0)
-      << log;
-  ASSERT_EQ(test::run_command(
-                test::cli_path() + " perturb --mesh " + out + "/spot/mesh.obj --layout " + out +
-                    "/spot/layout.json --rings 2 --seed 1 --out " + out + "/displaced.layout.json",
-                &log),
-            0)
-      << log;
-  ASSERT_EQ(test::run_command(test::cli_path() + " optimize --keep-nodes-apart --mesh " + out +
-                                  "/spot/mesh.obj --layout " + out +
-                                  "/displaced.layout.json --out " + out + "/run",
-                              &log),
-            0)
-      << log;
-  const auto report = read_json(out + "/run/report.json");
-  const auto& node = report["node_optimization"];
-  EXPECT_FALSE(node.contains("keep_apart_retry"));
-  ASSERT_TRUE(node.contains("sizing_retry")) << log;
-  const auto& retry = node["sizing_retry"];
-  ASSERT_TRUE(retry["initial_without"].get<bool>()) << "the case must fall back to the start";
-  EXPECT_EQ(retry["foldovers_without"].get<int>(), 0);
-  EXPECT_EQ(retry["foldovers_with"].get<int>(), 0);
-  EXPECT_FALSE(retry["initial_with"].get<bool>());
-  EXPECT_TRUE(retry["used"].get<bool>());
-  EXPECT_TRUE(report["parameterization"]["sizing"].get<bool>());
-  EXPECT_TRUE(node["keep_nodes_apart"].get<bool>());
-  EXPECT_FALSE(node["initial_reverted"].get<bool>());
-  EXPECT_EQ(report["metrics"]["foldovers"].get<int>(), 0);
-  EXPECT_TRUE(report["structurally_equivalent"].get<bool>());
-  EXPECT_NE(log.find("fell back to the initial state; optimizing again from the input with the "
-                     "sizing field"),
-            std::string::npos)
-      << log;
-  std::printf(
-      "[stat] displaced spot, nodes kept apart: E %.6g at the initial state, sized run "
-      "E %.6g\n",
-      retry["E_final_without"].get<double>(), retry["E_final_with"].get<double>());
-}
+// The sizing retry after a fallback to the initial state (the displaced spot with nodes kept
+// apart did so on an AMD EPYC, not on an Intel Xeon: CI of b6fb649): its rules are tested on
+// results made to order in retry_test.cpp (RetryRules.SizingRetryAfterAFallback...).
 
 }  // namespace
 }  // namespace qs

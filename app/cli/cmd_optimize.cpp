@@ -18,6 +18,7 @@
 #include "core/nodeopt/discrete.h"
 #include "core/nodeopt/gradient.h"
 #include "core/nodeopt/optimizer.h"
+#include "core/nodeopt/retry.h"
 #include "core/pipeline/integer_sizes.h"
 #include "core/pipeline/pipeline.h"
 
@@ -199,15 +200,6 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       if (may_retry || may_retry_apart) input_mesh = mesh, input_layout = layout;
       const PipelineOptions input_options = options;
       adopt(optimize(mesh, layout, options, keep_apart));
-      const auto fell_back = [](const NodeOptResult& r) {
-        return r.fewest_foldovers_reverted || r.initial_reverted;
-      };
-      // Fold-overs left, or removed only by the untangling (the orientation constraints failed at
-      // every state tried): the untangled map keeps its state's parametric cones, so a retry
-      // that embeds through the constraints is preferred at equal fold-overs.
-      const auto unembedded = [](const NodeOptResult& r) {
-        return r.foldovers_final > 0 || r.untangled;
-      };
       // One retry from the input with \p run_options and \p apart (\p with names it, \p flags
       // the options that decide it up front). The retry's run is adopted when \p better(retry,
       // first) says so (`used` in the report entry, to which the caller adds its own fields).
@@ -259,17 +251,11 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       // optimized layouts fail (docs/benchmarks.md session 27: the default falls back to the
       // initial state, E 2.048; kept apart, E 1.578 and no fold-overs). Not the default itself:
       // crowded starts (the displaced spot) then keep fold-overs the default removes.
-      if (may_retry_apart && !node_result->stopped &&
-          (unembedded(*node_result) || fell_back(*node_result))) {
+      // The rules: core/nodeopt/retry.h.
+      if (may_retry_apart && wants_keep_apart_retry(*node_result)) {
         const bool fell_back_without = fell_back(*node_result);
-        Retry r =
-            retry("nodes kept apart", "--keep-nodes-apart or --no-keep-nodes-apart", input_options,
-                  true, [](const NodeOptResult& run, const NodeOptResult& first) {
-                    if (run.foldovers_final != first.foldovers_final)
-                      return run.foldovers_final < first.foldovers_final;
-                    if (run.untangled != first.untangled) return !run.untangled;
-                    return run.E_final < first.E_final;
-                  });
+        Retry r = retry("nodes kept apart", "--keep-nodes-apart or --no-keep-nodes-apart",
+                        input_options, true, keep_apart_retry_is_better);
         apart_retry = std::move(r.entry);
         apart_retry["fell_back_without"] = fell_back_without;
         if (r.used) {
@@ -287,18 +273,12 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       // criterion here: the sizing field changes the energy. An explicit --sizing or
       // --no-sizing decides up front; --no-orientation (stiffening only, an ablation) and the
       // discrete baseline are run as asked.
-      if (may_retry && !node_result->stopped &&
-          (unembedded(*node_result) || node_result->initial_reverted)) {
+      if (may_retry && wants_sizing_retry(*node_result)) {
         PipelineOptions sized = input_options;
         sized.param.sizing.enabled = true;
         const bool initial_without = node_result->initial_reverted;
         Retry r = retry("the sizing field", "--sizing or --no-sizing", sized, keep_apart,
-                        [](const NodeOptResult& run, const NodeOptResult& first) {
-                          return run.foldovers_final < first.foldovers_final ||
-                                 (run.foldovers_final == first.foldovers_final &&
-                                  ((first.initial_reverted && !run.initial_reverted) ||
-                                   (first.untangled && !run.untangled)));
-                        });
+                        sizing_retry_is_better);
         sizing_retry = std::move(r.entry);
         sizing_retry["initial_without"] = initial_without;
         sizing_retry["initial_with"] = r.run.initial_reverted;

@@ -1150,7 +1150,9 @@ struct NodeOptimizer::Impl {
 
       // Fold-over removal: strict orientation constraints in the last solve (algorithm.md §7.2),
       // stiffening (§7.1) only as the fallback when fold-overs remain.
-      if (no.orientation_at_end && ev.foldovers > 0) {
+      const bool at_this_state =
+          no.orientation_at_moved_states || (initial_state && same_state(*initial_state, st_in));
+      if (no.orientation_at_end && ev.foldovers > 0 && at_this_state) {
         const auto t_or = std::chrono::steady_clock::now();
         check_cancel(obs);
         try {

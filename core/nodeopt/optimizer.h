@@ -222,6 +222,14 @@ struct NodeOptOptions {
   //! the user put its nodes is not handed back folded. The exact cow (`import-quads --refine
   //! 3`) kept 121 fold-overs after stiffening at E 2.19; its initial state embeds at E 3.62.
   bool initial_fallback = true;
+  //! Diagnostics and the fallback's tests: false skips the orientation-constrained solve at
+  //! every state whose nodes or vertices moved (the final state, before the polish, the fewest
+  //! fold-overs), as if it had left their fold-overs, so that only the initial state's solve
+  //! (initial_fallback) can remove them: whether the sketch itself embeds, and the fallback
+  //! chain on any input (real cases that need it depend on the descent's rounding: the
+  //! displaced spot with nodes kept apart did on an AMD EPYC, not on an Intel Xeon). Stiffening
+  //! still runs where fold-overs remain.
+  bool orientation_at_moved_states = true;
   bool stiffen_at_end = true;  //!< stiffening (§7.1) when fold-overs remain after that
   StiffeningOptions stiffening;
   //! Ends the node movement early when it returns true (a time limit): polled before each
