@@ -16,18 +16,18 @@ bool fell_back(const NodeOptResult& r);
 //! every state tried; an untangled map keeps its state's parametric cones).
 bool unembedded(const NodeOptResult& r);
 
-//! The keep-apart retry (NodeOptOptions::keep_nodes_apart) is run after \p first when the user
-//! left that choice to the default and the run was not stopped early: fold-overs remain, only the
-//! untangling removed them, or the removal fell back to an earlier state.
+//! The keep-apart retry (NodeOptOptions::keep_nodes_apart) is wanted after \p first, not stopped
+//! early, when fold-overs remain, only the untangling removed them, or the removal fell back to
+//! an earlier state (whether the user left the choice to the default is the caller's check).
 bool wants_keep_apart_retry(const NodeOptResult& first);
 
 //! The keep-apart retry \p run replaces \p first when it ends with fewer fold-overs; at as many,
 //! when it needs no untangling where \p first did; at that too, when its E is lower.
 bool keep_apart_retry_is_better(const NodeOptResult& run, const NodeOptResult& first);
 
-//! The sizing retry (ParamOptions::sizing) is run after \p first when fold-overs remain, only the
-//! untangling removed them, or the run embedded only its initial state (the node movement given
-//! up), and it was not stopped early.
+//! The sizing retry (ParamOptions::sizing) is wanted after \p first, not stopped early, when
+//! fold-overs remain, only the untangling removed them, or the run embedded only its initial
+//! state (the node movement given up); the user's explicit choice is the caller's check.
 bool wants_sizing_retry(const NodeOptResult& first);
 
 //! The sizing retry \p run replaces \p first when it ends with fewer fold-overs, or with as many
