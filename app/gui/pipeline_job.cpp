@@ -12,6 +12,7 @@
 #include "core/layout/layout.h"
 #include "core/layout/layout_io.h"
 #include "core/nodeopt/optimizer.h"
+#include "core/nodeopt/retry.h"
 #include "core/pipeline/pipeline.h"
 
 namespace qs::app {
@@ -330,15 +331,17 @@ StepResult pipeline_step(WorkerState& state, const WorkerObserver& observer) {
                 "unfolded at an earlier step (the one with the fewest fold-overs)";
     // What `quadsketch-cli optimize` does by itself in these cases (its retries), offered.
     std::vector<std::string> offers;
-    if ((end.foldovers_final > 0 || end.initial_reverted || end.fewest_foldovers_reverted) &&
-        !state.options.keep_nodes_apart)
+    // The same rules as the command line's (core/nodeopt/retry.h); the user's current choice
+    // here is the check that the command line makes on explicit flags.
+    if (wants_keep_apart_retry(end) && !state.options.keep_nodes_apart)
       offers.push_back("'Keep nodes apart'");
-    if ((end.foldovers_final > 0 || end.initial_reverted) && !state.options.sizing)
-      offers.push_back("'Sizing field'");
+    if (wants_sizing_retry(end) && !state.options.sizing) offers.push_back("'Sizing field'");
     if (!offers.empty()) {
       prefix += std::string(prefix.empty() ? "" : "; ");
       if (end.foldovers_final > 0)
         prefix += std::to_string(end.foldovers_final) + " fold-over(s) remain: ";
+      else if (end.untangled)
+        prefix += "only the untangling removed the fold-overs: ";
       prefix += "turn on " + offers[0] + (offers.size() > 1 ? " or " + offers[1] : "") +
                 " and Run again (the command line retries with " +
                 (offers.size() > 1 ? "them" : "it") + " by itself)";
