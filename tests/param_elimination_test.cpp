@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <random>
 
 #include "core/base/errors.h"
@@ -180,6 +181,74 @@ TEST(ReducedAssembly, MatchesSparseTripleProduct) {
       EXPECT_LT((Eigen::MatrixXd(ra.H()) - Eigen::MatrixXd(H)).cwiseAbs().maxCoeff(), 1e-12);
     }
   }
+}
+
+// Large matrices: the pattern built from wedge_pattern() with A's columns in two halves on two
+// threads is the one-thread pattern (same arrays), and A's values are ZᵀHZ's (sparse check).
+TEST(ReducedAssembly, TwoThreadPatternIsTheOneThreadPattern) {
+  std::mt19937 rng(5);
+  const int wedges = 12000, extra = 8, n = 2 * wedges + extra, nf = 20000;
+  std::vector<int> corner_wedge(3 * nf);
+  for (int f = 0; f < nf; ++f) {
+    const int a = static_cast<int>(rng() % (wedges - 40));
+    corner_wedge[3 * f] = a, corner_wedge[3 * f + 1] = a + 1 + static_cast<int>(rng() % 19);
+    corner_wedge[3 * f + 2] = a + 20 + static_cast<int>(rng() % 19);
+  }
+  std::vector<Eigen::Triplet<double>> t;
+  std::vector<int> col(n, -1);
+  int m = 0;
+  for (int v = 0; v < n; ++v)
+    if (v % 5 != 2) col[v] = m++;
+  ASSERT_GE(m, 16384) << "the case must reach the two-thread size";
+  for (int v = 0; v < n; ++v) {
+    if (col[v] >= 0) {
+      t.emplace_back(v, col[v], 1.0);
+      continue;
+    }
+    t.emplace_back(v, col[(v + 1) % n], 1.0);
+    t.emplace_back(v, col[(v + 4) % n], -1.0);
+    if (v % 3 == 0)  // two dense columns used by a third of the eliminated rows
+      for (int k = 0; k < 2; ++k) t.emplace_back(v, m - 1 - k, k ? 0.5 : -1.0);
+  }
+  Eigen::SparseMatrix<double> Z(n, m);
+  Z.setFromTriplets(t.begin(), t.end());
+  ReducedAssembly one(ReducedAssembly::wedge_pattern(corner_wedge, wedges), n, Z, false);
+  ReducedAssembly two(ReducedAssembly::wedge_pattern(corner_wedge, wedges), n, Z, true);
+  EXPECT_EQ(one.reduce_flops(), two.reduce_flops());
+  std::vector<Eigen::Triplet<double>> ht;
+  for (ReducedAssembly* ra : {&one, &two}) ra->clear();
+  for (int f = 0; f < nf; ++f) {
+    Eigen::Matrix3d B = Eigen::Matrix3d::Random();
+    const Eigen::Matrix3d Hu = B * B.transpose();
+    B = Eigen::Matrix3d::Random();
+    const Eigen::Matrix3d Hv = B * B.transpose();
+    for (ReducedAssembly* ra : {&one, &two}) ra->add_face(f, Hu, Hv);
+    for (int k = 0; k < 3; ++k)
+      for (int l = 0; l < 3; ++l) {
+        ht.emplace_back(2 * corner_wedge[3 * f + k], 2 * corner_wedge[3 * f + l], Hu(k, l));
+        ht.emplace_back(2 * corner_wedge[3 * f + k] + 1, 2 * corner_wedge[3 * f + l] + 1, Hv(k, l));
+      }
+  }
+  one.reduce();
+  two.reduce();
+  const auto& A1 = one.A();
+  const auto& A2 = two.A();
+  ASSERT_EQ(A1.nonZeros(), A2.nonZeros());
+  EXPECT_TRUE(std::equal(A1.outerIndexPtr(), A1.outerIndexPtr() + m + 1, A2.outerIndexPtr()));
+  EXPECT_TRUE(
+      std::equal(A1.innerIndexPtr(), A1.innerIndexPtr() + A1.nonZeros(), A2.innerIndexPtr()));
+  EXPECT_TRUE(std::equal(A1.valuePtr(), A1.valuePtr() + A1.nonZeros(), A2.valuePtr()));
+  Eigen::SparseMatrix<double> H(n, n);
+  H.setFromTriplets(ht.begin(), ht.end());
+  const Eigen::SparseMatrix<double> expected = Z.transpose() * H * Z;
+  const Eigen::SparseMatrix<double> diff = A2 - expected;
+  double max_diff = 0, max_expected = 0;
+  for (int k = 0; k < diff.nonZeros(); ++k)
+    max_diff = std::max(max_diff, std::abs(diff.valuePtr()[k]));
+  for (int k = 0; k < expected.nonZeros(); ++k)
+    max_expected = std::max(max_expected, std::abs(expected.valuePtr()[k]));
+  EXPECT_GT(max_expected, 0.0);
+  EXPECT_LT(max_diff, 1e-12 * max_expected);
 }
 
 // A second solver for the same combinatorics takes over the first one's CHOLMOD analysis and

@@ -2,14 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
 
 #include "core/base/errors.h"
 
 namespace qs {
 
-ReducedAssembly::ReducedAssembly(const std::vector<int>& corner_wedge, int wedges, int n,
-                                 const Eigen::SparseMatrix<double>& Z) {
-  if (n < 2 * wedges || Z.rows() != n || corner_wedge.size() % 3 != 0)
+ReducedAssembly::WedgePattern ReducedAssembly::wedge_pattern(const std::vector<int>& corner_wedge,
+                                                             int wedges) {
+  if (wedges < 0 || corner_wedge.size() % 3 != 0)
     throw QsError("internal error: ReducedAssembly sizes disagree");
   const int nf = static_cast<int>(corner_wedge.size()) / 3;
   for (int w : corner_wedge)
@@ -18,6 +19,8 @@ ReducedAssembly::ReducedAssembly(const std::vector<int>& corner_wedge, int wedge
   // Per wedge w (sequentially, so the writes to H's pattern are sequential): the wedges
   // sharing a face with it (itself included), sorted, give H's columns 2w (rows 2w', u) and
   // 2w + 1 (rows 2w' + 1, v); the slots of w's corners' face blocks follow from the positions.
+  WedgePattern pat;
+  pat.wedges = wedges;
   std::vector<int> wc_start(wedges + 1, 0), wc(corner_wedge.size());
   for (int w : corner_wedge) ++wc_start[w + 1];
   for (int w = 0; w < wedges; ++w) wc_start[w + 1] += wc_start[w];
@@ -25,52 +28,69 @@ ReducedAssembly::ReducedAssembly(const std::vector<int>& corner_wedge, int wedge
     std::vector<int> next(wc_start.begin(), wc_start.end() - 1);
     for (int c = 0; c < 3 * nf; ++c) wc[next[corner_wedge[c]]++] = c;
   }
-  std::vector<int> hp(n + 1, 0), hi;
+  std::vector<int>& hp = pat.outer;
+  std::vector<int>& hi = pat.inner;
+  hp.assign(2 * static_cast<size_t>(wedges) + 1, 0);
   hi.reserve(static_cast<size_t>(16) * wedges);
-  face_slot_.resize(18 * static_cast<size_t>(nf));
-  {
-    std::vector<int> mark(wedges, -1), pos(wedges, 0), list;
-    for (int w = 0; w < wedges; ++w) {
-      list.clear();
-      for (int q = wc_start[w]; q < wc_start[w + 1]; ++q) {
-        const int* fw = &corner_wedge[3 * (wc[q] / 3)];
-        for (int k = 0; k < 3; ++k)
-          if (mark[fw[k]] != w) {
-            mark[fw[k]] = w;
-            list.push_back(fw[k]);
-          }
-      }
-      for (size_t i = 1; i < list.size(); ++i) {  // insertion sort: a handful of wedges
-        const int x = list[i];
-        size_t j = i;
-        for (; j > 0 && list[j - 1] > x; --j) list[j] = list[j - 1];
-        list[j] = x;
-      }
-      const int len = static_cast<int>(list.size());
-      const int base = static_cast<int>(hi.size());
-      hp[2 * w] = base;
-      hp[2 * w + 1] = base + len;
-      for (int i = 0; i < len; ++i) {
-        pos[list[i]] = i;
-        hi.push_back(2 * list[i]);
-      }
-      for (int i = 0; i < len; ++i) hi.push_back(2 * list[i] + 1);
-      for (int q = wc_start[w]; q < wc_start[w + 1]; ++q) {
-        const int f = wc[q] / 3, l = wc[q] % 3;
-        int* slot = &face_slot_[18 * static_cast<size_t>(f)];
-        for (int k = 0; k < 3; ++k) {
-          const int p = pos[corner_wedge[3 * f + k]];
-          slot[3 * k + l] = base + p;
-          slot[9 + 3 * k + l] = base + len + p;
+  pat.face_slot.resize(18 * static_cast<size_t>(nf));
+  std::vector<int> mark(wedges, -1), pos(wedges, 0), list;
+  for (int w = 0; w < wedges; ++w) {
+    list.clear();
+    for (int q = wc_start[w]; q < wc_start[w + 1]; ++q) {
+      const int* fw = &corner_wedge[3 * (wc[q] / 3)];
+      for (int k = 0; k < 3; ++k)
+        if (mark[fw[k]] != w) {
+          mark[fw[k]] = w;
+          list.push_back(fw[k]);
         }
+    }
+    for (size_t i = 1; i < list.size(); ++i) {  // insertion sort: a handful of wedges
+      const int x = list[i];
+      size_t j = i;
+      for (; j > 0 && list[j - 1] > x; --j) list[j] = list[j - 1];
+      list[j] = x;
+    }
+    const int len = static_cast<int>(list.size());
+    const int base = static_cast<int>(hi.size());
+    hp[2 * w] = base;
+    hp[2 * w + 1] = base + len;
+    for (int i = 0; i < len; ++i) {
+      pos[list[i]] = i;
+      hi.push_back(2 * list[i]);
+    }
+    for (int i = 0; i < len; ++i) hi.push_back(2 * list[i] + 1);
+    for (int q = wc_start[w]; q < wc_start[w + 1]; ++q) {
+      const int f = wc[q] / 3, l = wc[q] % 3;
+      int* slot = &pat.face_slot[18 * static_cast<size_t>(f)];
+      for (int k = 0; k < 3; ++k) {
+        const int p = pos[corner_wedge[3 * f + k]];
+        slot[3 * k + l] = base + p;
+        slot[9 + 3 * k + l] = base + len + p;
       }
     }
-    for (int col = 2 * wedges; col <= n; ++col) hp[col] = static_cast<int>(hi.size());
   }
+  hp[2 * static_cast<size_t>(wedges)] = static_cast<int>(hi.size());
+  return pat;
+}
+
+ReducedAssembly::ReducedAssembly(const std::vector<int>& corner_wedge, int wedges, int n,
+                                 const Eigen::SparseMatrix<double>& Z)
+    : ReducedAssembly(wedge_pattern(corner_wedge, wedges), n, Z) {}
+
+ReducedAssembly::ReducedAssembly(WedgePattern pattern, int n, const Eigen::SparseMatrix<double>& Z,
+                                 bool second_thread) {
+  const int wedges = pattern.wedges;
+  if (n < 2 * wedges || Z.rows() != n ||
+      pattern.outer.size() != 2 * static_cast<size_t>(wedges) + 1)
+    throw QsError("internal error: ReducedAssembly sizes disagree");
+  face_slot_ = std::move(pattern.face_slot);
   H_.resize(n, n);
-  H_.resizeNonZeros(static_cast<Eigen::Index>(hi.size()));
-  std::copy(hp.begin(), hp.end(), H_.outerIndexPtr());
-  std::copy(hi.begin(), hi.end(), H_.innerIndexPtr());
+  H_.resizeNonZeros(static_cast<Eigen::Index>(pattern.inner.size()));
+  std::copy(pattern.outer.begin(), pattern.outer.end(), H_.outerIndexPtr());
+  // The unknowns past the wedges (seam translations) have empty columns.
+  std::fill(H_.outerIndexPtr() + 2 * wedges + 1, H_.outerIndexPtr() + n + 1,
+            static_cast<int>(pattern.inner.size()));
+  std::copy(pattern.inner.begin(), pattern.inner.end(), H_.innerIndexPtr());
   std::fill(H_.valuePtr(), H_.valuePtr() + H_.nonZeros(), 0.0);
 
   // Z by columns and rows; dense columns D.
@@ -148,69 +168,93 @@ ReducedAssembly::ReducedAssembly(const std::vector<int>& corner_wedge, int wedge
   w_.assign(static_cast<size_t>(w_rows_.size()) * d_, 0.0);
   c_.assign(static_cast<size_t>(c_rows_) * d_, 0.0);
 
-  // Lower triangle of A (row ≥ column) with the source of every entry.
-  constexpr int A_reserve_factor = 8;  // lower entries per column, a guess (grows if needed)
-  lower_outer_.assign(m + 1, 0);
-  lower_rows_.clear();
-  lower_src_.clear();
-  lower_rows_.reserve(static_cast<size_t>(A_reserve_factor) * m);
-  lower_src_.reserve(static_cast<size_t>(A_reserve_factor) * m);
-  std::vector<int> mark(m, -1), column;
-  flops_ = 0;
-  for (int b = 0; b < m; ++b) {
-    column.clear();
-    const int pb = dense_pos_[b];
-    if (pb < 0) {
-      for (int zq = Z_.outerIndexPtr()[b]; zq < Z_.outerIndexPtr()[b + 1]; ++zq) {
-        const int j = Z_.innerIndexPtr()[zq];
-        for (int k = h_outer[j]; k < h_outer[j + 1]; ++k) {
-          const int i = h_inner[k];
-          for (int q = s_outer_[i]; q < s_outer_[i + 1]; ++q) {
-            const int a = s_col_[q];
-            if (a < b) continue;
-            ++flops_;
-            if (mark[a] != b) {
-              mark[a] = b;
-              column.push_back(a);
+  // Lower triangle of A (row ≥ column) with the source of every entry, for the columns
+  // [b0, b1): rows and sources appended to \p out, out.end[b − b0] after column b.
+  struct Columns {
+    std::vector<int> rows, src, end;
+    long flops = 0;
+  };
+  auto lower_columns = [&](int b0, int b1, Columns& out) {
+    constexpr int reserve_factor = 8;  // lower entries per column, a guess (grows if needed)
+    out.rows.reserve(static_cast<size_t>(reserve_factor) * (b1 - b0));
+    out.src.reserve(static_cast<size_t>(reserve_factor) * (b1 - b0));
+    out.end.resize(b1 - b0);
+    std::vector<int> mark(m, -1), column;
+    for (int b = b0; b < b1; ++b) {
+      column.clear();
+      const int pb = dense_pos_[b];
+      if (pb < 0) {
+        for (int zq = Z_.outerIndexPtr()[b]; zq < Z_.outerIndexPtr()[b + 1]; ++zq) {
+          const int j = Z_.innerIndexPtr()[zq];
+          for (int k = h_outer[j]; k < h_outer[j + 1]; ++k) {
+            const int i = h_inner[k];
+            for (int q = s_outer_[i]; q < s_outer_[i + 1]; ++q) {
+              const int a = s_col_[q];
+              if (a < b) continue;
+              ++out.flops;
+              if (mark[a] != b) {
+                mark[a] = b;
+                column.push_back(a);
+              }
             }
           }
         }
-      }
-      if (column.size() <= 32) {  // insertion sort: columns hold a few dozen rows
-        for (size_t i = 1; i < column.size(); ++i) {
-          const int x = column[i];
-          size_t j = i;
-          for (; j > 0 && column[j - 1] > x; --j) column[j] = column[j - 1];
-          column[j] = x;
+        if (column.size() <= 32) {  // insertion sort: columns hold a few dozen rows
+          for (size_t i = 1; i < column.size(); ++i) {
+            const int x = column[i];
+            size_t j = i;
+            for (; j > 0 && column[j - 1] > x; --j) column[j] = column[j - 1];
+            column[j] = x;
+          }
+        } else {
+          std::sort(column.begin(), column.end());
+        }
+        // A(d, b) = A(b, d) = C(b, d) for the dense columns d > b, merged in (both sorted).
+        size_t q = 0;
+        if (c_index_[b] >= 0)
+          for (int p = 0; p < d_; ++p) {
+            if (dense_cols[p] <= b) continue;
+            for (; q < column.size() && column[q] < dense_cols[p]; ++q) {
+              out.rows.push_back(column[q]);
+              out.src.push_back(-1);
+            }
+            out.rows.push_back(dense_cols[p]);
+            out.src.push_back(c_index_[b] * d_ + p);
+          }
+        for (; q < column.size(); ++q) {
+          out.rows.push_back(column[q]);
+          out.src.push_back(-1);
         }
       } else {
-        std::sort(column.begin(), column.end());
-      }
-      // A(d, b) = A(b, d) = C(b, d) for the dense columns d > b, merged in (both sorted).
-      size_t q = 0;
-      if (c_index_[b] >= 0)
-        for (int p = 0; p < d_; ++p) {
-          if (dense_cols[p] <= b) continue;
-          for (; q < column.size() && column[q] < dense_cols[p]; ++q) {
-            lower_rows_.push_back(column[q]);
-            lower_src_.push_back(-1);
+        for (int a : c_list)  // sorted
+          if (a >= b) {
+            out.rows.push_back(a);
+            out.src.push_back(c_index_[a] * d_ + pb);
           }
-          lower_rows_.push_back(dense_cols[p]);
-          lower_src_.push_back(c_index_[b] * d_ + p);
-        }
-      for (; q < column.size(); ++q) {
-        lower_rows_.push_back(column[q]);
-        lower_src_.push_back(-1);
       }
-    } else {
-      for (int a : c_list)  // sorted
-        if (a >= b) {
-          lower_rows_.push_back(a);
-          lower_src_.push_back(c_index_[a] * d_ + pb);
-        }
+      out.end[b - b0] = static_cast<int>(out.rows.size());
     }
-    lower_outer_[b + 1] = static_cast<int>(lower_rows_.size());
+  };
+  // Two halves of the columns on two threads for large matrices (the same pattern).
+  constexpr int kThreadColumns = 16384;
+  const int split = second_thread && m >= kThreadColumns ? m / 2 : m;
+  Columns first, second;
+  if (split < m) {
+    auto other = std::async(std::launch::async, [&]() { lower_columns(split, m, second); });
+    lower_columns(0, split, first);
+    other.get();
+  } else {
+    lower_columns(0, m, first);
   }
+  lower_outer_.assign(m + 1, 0);
+  for (int b = 0; b < split; ++b) lower_outer_[b + 1] = first.end[b];
+  for (int b = split; b < m; ++b)
+    lower_outer_[b + 1] = static_cast<int>(first.rows.size()) + second.end[b - split];
+  lower_rows_ = std::move(first.rows);
+  lower_src_ = std::move(first.src);
+  lower_rows_.insert(lower_rows_.end(), second.rows.begin(), second.rows.end());
+  lower_src_.insert(lower_src_.end(), second.src.begin(), second.src.end());
+  flops_ = first.flops + second.flops;
   for (int j : t_rows_)
     flops_ += static_cast<long>(h_outer[j + 1] - h_outer[j]) * (t_outer_[j + 1] - t_outer_[j]);
   for (int i : w_rows_) flops_ += static_cast<long>(zr_outer_[i + 1] - zr_outer_[i]) * d_;

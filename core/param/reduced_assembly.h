@@ -39,12 +39,29 @@ class MovableSparse : public Eigen::SparseMatrix<double> {
 class ReducedAssembly {
  public:
   ReducedAssembly() = default;
+
+  //! H's pattern on the wedge unknowns and the faces' slots in it: it depends on corner_wedge
+  //! only, so it can be built before (or beside) the constraint elimination that gives Z.
+  struct WedgePattern {
+    int wedges = 0;
+    std::vector<int> outer;      //!< 2·wedges + 1 column starts
+    std::vector<int> inner;      //!< row indices, sorted within each column
+    std::vector<int> face_slot;  //!< 18 per face: (k, l) of u at 3k + l, of v at 9 + 3k + l
+  };
+  //! \p corner_wedge: wedge of each face corner (size 3·#F, corner k of face f at 3f + k).
+  static WedgePattern wedge_pattern(const std::vector<int>& corner_wedge, int wedges);
+
   //! \p corner_wedge: wedge of each face corner (size 3·#F, corner k of face f at 3f + k);
   //! wedge w owns the unknowns 2w (u) and 2w + 1 (v). \p variables ≥ 2·wedges: the unknowns x
   //! (the ones past the wedges, e.g. seam translations, have no energy term). \p Z: the
   //! elimination x = Z·y + z0 (variables × free).
   ReducedAssembly(const std::vector<int>& corner_wedge, int wedges, int variables,
                   const Eigen::SparseMatrix<double>& Z);
+  //! The same from a pattern built by wedge_pattern(). \p second_thread: A's pattern (the
+  //! symbolic ZᵀHZ) is built in two halves of its columns, one on a second thread, when A has
+  //! at least 16384 columns (the same pattern either way).
+  ReducedAssembly(WedgePattern pattern, int variables, const Eigen::SparseMatrix<double>& Z,
+                  bool second_thread = false);
 
   //! Zeroes H's values.
   void clear();
