@@ -43,11 +43,14 @@ for step in "${steps[@]}"; do
     tsan)
       configure "$root/build-tsan" -DQS_SANITIZE=thread
       cmake --build "$root/build-tsan" -j"$jobs" \
-        --target worker_test spd_solver_test param_test nodeopt_test reuse_test
+        --target worker_test spd_solver_test param_test param_elimination_test nodeopt_test \
+        reuse_test
       "$root/build-tsan/tests/worker_test" --gtest_brief=1
       "$root/build-tsan/tests/spd_solver_test" --gtest_brief=1
       "$root/build-tsan/tests/param_test" --gtest_brief=1 \
         --gtest_filter='Parameterization.SecondThread*'
+      "$root/build-tsan/tests/param_elimination_test" --gtest_brief=1 \
+        --gtest_filter='ReducedAssembly.TwoThread*'
       "$root/build-tsan/tests/nodeopt_test" --gtest_brief=1 \
         --gtest_filter='NodeOptimizer.Parallel*:DiscreteRelocation.Parallel*'
       "$root/build-tsan/tests/reuse_test" --gtest_brief=1 \

@@ -246,6 +246,22 @@ TEST(Parameterization, SecondThreadGivesIdenticalResults) {
   }
 }
 
+// On a mesh large enough for the set-up's threads (H's wedge pattern beside the elimination
+// from 8192 wedges, A's pattern in two halves from 16384 unknowns): the same solve, bitwise.
+TEST(Parameterization, SecondThreadGivesIdenticalResultsOnALargeMesh) {
+  const auto in = test::cube_sphere(40);
+  ParamOptions one, two;
+  one.second_thread = false;
+  two.second_thread = true;
+  const Solved a = solve_all(in, one), b = solve_all(in, two);
+  ASSERT_GE(b.param->result().wedges, 8192) << "the case must reach the threaded set-up";
+  ASSERT_GE(b.param->result().unknowns, 16384) << "the case must reach the threaded set-up";
+  EXPECT_EQ(a.param->result().unknowns, b.param->result().unknowns);
+  EXPECT_EQ(a.param->result().corner_uv, b.param->result().corner_uv);
+  EXPECT_EQ(a.param->result().energy, b.param->result().energy);
+  EXPECT_EQ(b.param->result().foldovers, 0);
+}
+
 // ParamSolver(…, solve_now = false): no result until the first solve, which then equals the
 // constructor's own solve; the analysis started in the constructor is the only one, and a
 // solver destroyed before any solve waits for it (run under TSan in CI).
