@@ -159,15 +159,13 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
     labeling_ = label_layout(mesh, g, layout, topo, p, theta);
   }
   // H's pattern on the wedges needs the cut only: on a large mesh, built on a second thread
-  // beside the constraint rows and their elimination. (std::async's future waits in its
-  // destructor if they throw; it reads cut_, a member.)
+  // beside the constraint rows and their elimination, else where it is collected. (std::async's
+  // future waits in its destructor if they throw; it reads cut_, a member.)
   constexpr int kThreadWedges = 8192;
-  const bool pattern_beside = options_.second_thread && cut_.wedges >= kThreadWedges;
-  std::future<ReducedAssembly::WedgePattern> wedge_pattern;
-  if (pattern_beside)
-    wedge_pattern = std::async(std::launch::async, [this]() {
-      return ReducedAssembly::wedge_pattern(cut_.corner_wedge, cut_.wedges);
-    });
+  std::future<ReducedAssembly::WedgePattern> wedge_pattern = std::async(
+      options_.second_thread && cut_.wedges >= kThreadWedges ? std::launch::async
+                                                             : std::launch::deferred,
+      [this]() { return ReducedAssembly::wedge_pattern(cut_.corner_wedge, cut_.wedges); });
   system_.variables = 2 * cut_.wedges;
 
   auto add_row = [&](Terms terms, double rhs, int origin) {
@@ -364,10 +362,8 @@ ParamSolver::ParamSolver(const TriMesh& mesh, const GeometryCache& g, const Layo
     add_row(row.along_u ? d.v : d.u, 0.0, o);
   }
   reduction_ = eliminate_constraints(system_);
-  assembly_ = ReducedAssembly(pattern_beside
-                                  ? wedge_pattern.get()
-                                  : ReducedAssembly::wedge_pattern(cut_.corner_wedge, cut_.wedges),
-                              system_.variables, reduction_.Z, options_.second_thread);
+  assembly_ =
+      ReducedAssembly(wedge_pattern.get(), system_.variables, reduction_.Z, options_.second_thread);
   result_.wedges = cut_.wedges;
   result_.cut_edges = cut_.cut_edges;
   result_.constraint_rows = static_cast<int>(system_.rows.size());

@@ -8,6 +8,24 @@
 
 namespace qs {
 
+namespace {
+
+// Sorts a list of a few dozen indices at most in place (insertion sort; std::sort beyond).
+void sort_short(std::vector<int>& v) {
+  if (v.size() > 32) {
+    std::sort(v.begin(), v.end());
+    return;
+  }
+  for (size_t i = 1; i < v.size(); ++i) {
+    const int x = v[i];
+    size_t j = i;
+    for (; j > 0 && v[j - 1] > x; --j) v[j] = v[j - 1];
+    v[j] = x;
+  }
+}
+
+}  // namespace
+
 ReducedAssembly::WedgePattern ReducedAssembly::wedge_pattern(const std::vector<int>& corner_wedge,
                                                              int wedges) {
   if (wedges < 0 || corner_wedge.size() % 3 != 0)
@@ -44,12 +62,7 @@ ReducedAssembly::WedgePattern ReducedAssembly::wedge_pattern(const std::vector<i
           list.push_back(fw[k]);
         }
     }
-    for (size_t i = 1; i < list.size(); ++i) {  // insertion sort: a handful of wedges
-      const int x = list[i];
-      size_t j = i;
-      for (; j > 0 && list[j - 1] > x; --j) list[j] = list[j - 1];
-      list[j] = x;
-    }
+    sort_short(list);  // a handful of wedges
     const int len = static_cast<int>(list.size());
     const int base = static_cast<int>(hi.size());
     hp[2 * w] = base;
@@ -199,16 +212,7 @@ ReducedAssembly::ReducedAssembly(WedgePattern pattern, int n, const Eigen::Spars
             }
           }
         }
-        if (column.size() <= 32) {  // insertion sort: columns hold a few dozen rows
-          for (size_t i = 1; i < column.size(); ++i) {
-            const int x = column[i];
-            size_t j = i;
-            for (; j > 0 && column[j - 1] > x; --j) column[j] = column[j - 1];
-            column[j] = x;
-          }
-        } else {
-          std::sort(column.begin(), column.end());
-        }
+        sort_short(column);  // columns hold a few dozen rows
         // A(d, b) = A(b, d) = C(b, d) for the dense columns d > b, merged in (both sorted).
         size_t q = 0;
         if (c_index_[b] >= 0)
