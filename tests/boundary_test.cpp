@@ -70,7 +70,7 @@ void expect_embedding(const TriMesh& mesh, const Layout& layout, int expected_pa
 TEST(Boundary, FaceWithFourDanglingArcs) {
   const std::string dir = test::shared_meshes_dir();
   if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes is absent (real-mesh test)";
-  const TriMesh mesh = load_mesh(dir + "/face.obj");
+  const TriMesh mesh = test::load_mesh(dir + "/face.obj");
   const auto loops = boundary_loops(mesh);
   ASSERT_EQ(loops.size(), 1u);
   const auto& loop = loops[0];
@@ -87,7 +87,7 @@ TEST(Boundary, FaceWithFourDanglingArcs) {
 TEST(Boundary, MaskWithArcsIntoBothEyes) {
   const std::string dir = test::shared_meshes_dir();
   if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes is absent (real-mesh test)";
-  const TriMesh mesh = load_mesh(dir + "/mask_confmap.obj");
+  const TriMesh mesh = test::load_mesh(dir + "/mask_confmap.obj");
   const test::MaskStar star = test::mask_star(mesh);
   ASSERT_EQ(star.boundary_loops, 3u);
   ASSERT_NE(star.targets[1], star.targets[3]);  // up, down
@@ -230,8 +230,8 @@ TEST(Boundary, BoundaryNodesSlideOntoTheSquaresCorners) {
 // The base complex of libigl's conjugate-field quad mesh of inspired_mesh, coarsened to 15
 // nodes and routed onto the triangle mesh (\p dir: the shared meshes).
 QuadImportResult inspired_coarsened(const std::string& dir) {
-  const PolyMesh quads = load_poly_mesh(dir + "/inspired_mesh/inspired_mesh_quads_Conjugate.off");
-  const TriMesh target = load_mesh(dir + "/inspired_mesh/inspired_mesh.obj");
+  const PolyMesh quads = test::load_poly_mesh(dir + "/inspired_mesh/inspired_mesh_quads_Conjugate.off");
+  const TriMesh target = test::load_mesh(dir + "/inspired_mesh/inspired_mesh.obj");
   QuadImportOptions io;
   io.coarsen = 16;
   return import_quads(quads, &target, io);

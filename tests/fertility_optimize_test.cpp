@@ -38,7 +38,7 @@ const Optimized* optimized() {
     const std::string dir = test::shared_meshes_dir();
     if (dir.empty()) return nullptr;
     auto o = std::make_unique<Optimized>();
-    o->mesh = load_mesh(dir + "/fertility.obj");
+    o->mesh = test::load_mesh(dir + "/fertility.obj");
     o->cage = cage_layout(o->mesh, test::fertility_simplified_cage_options());
     o->patches = build_topology(o->mesh, o->cage.layout).patches.size();
     o->result = optimize_nodes(o->mesh, o->cage.layout, PipelineOptions{}, NodeOptOptions{});

@@ -751,7 +751,7 @@ Vec3 frozen_field_difference(const TriMesh& mesh, const GeometryCache& geometry,
 MeshAndLayout ellipsoid_example() {
   const std::string dir = assets_dir() + "/example/";
   MeshAndLayout e;
-  e.mesh = load_mesh(dir + "ellipsoid.obj");
+  e.mesh = test::load_mesh(dir + "ellipsoid.obj");
   e.layout = load_layout(dir + "ellipsoid.layout.json", e.mesh);
   return e;
 }

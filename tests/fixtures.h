@@ -12,6 +12,7 @@
 #include "core/mesh/geometry.h"
 #include "core/mesh/mesh.h"
 #include "core/pipeline/pipeline.h"
+#include "tests/jitter.h"
 
 namespace qs::test {
 
@@ -199,7 +200,8 @@ Vec3 frozen_field_difference(const TriMesh& mesh, const GeometryCache& geometry,
                              const std::vector<double>& theta, int v, double eps,
                              const MovedEnergy& energy);
 
-//! The bundled example (assets/example/ellipsoid.obj with the displaced sketch layout).
+//! The bundled example (assets/example/ellipsoid.obj with the displaced sketch layout), its
+//! mesh jittered under QS_TEST_JITTER (jitter.h).
 MeshAndLayout ellipsoid_example();
 
 //! How far the fields of two Pipelines on the same mesh are apart (both computed).

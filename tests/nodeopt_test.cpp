@@ -729,7 +729,7 @@ TEST(NodeOptimizer, CancelsBetweenSolves) {
 // still runs. The bundled sketch folds with its initial node positions.
 TEST(NodeOptimizer, StopEndsTheMovementAndTheFoldoverRemovalStillRuns) {
   const std::string dir = std::string(QS_ASSETS_DIR) + "/example/";
-  const TriMesh mesh = load_mesh(dir + "ellipsoid.obj");
+  const TriMesh mesh = test::load_mesh(dir + "ellipsoid.obj");
   const Layout layout = load_layout(dir + "ellipsoid.layout.json", mesh);
   const auto descent_steps = [](const Recorder& rec) {
     return std::count_if(rec.steps.begin(), rec.steps.end(),
@@ -1034,7 +1034,7 @@ TEST(NodeOptimizer, ReuseMatchesFreshPipelines) {
 // step at a time with the warm start (each call continues the previous Pipeline).
 TEST(NodeOptimizer, ReuseMatchesFreshPipelinesOnExample) {
   const std::string dir = std::string(QS_ASSETS_DIR) + "/example/";
-  TriMesh mesh = load_mesh(dir + "ellipsoid.obj");
+  TriMesh mesh = test::load_mesh(dir + "ellipsoid.obj");
   Layout layout = load_layout(dir + "ellipsoid.layout.json", mesh);
   PipelineOptions options;
   NodeOptOptions one;
@@ -1069,7 +1069,7 @@ TEST(NodeOptimizer, ReuseMatchesFreshPipelinesOnExample) {
 // The bundled example optimized with \p no, without fold-over removal after the descent.
 NodeOptResult optimize_example(NodeOptOptions no, NodeOptStats* stats) {
   const std::string dir = std::string(QS_ASSETS_DIR) + "/example/";
-  const TriMesh mesh = load_mesh(dir + "ellipsoid.obj");
+  const TriMesh mesh = test::load_mesh(dir + "ellipsoid.obj");
   const Layout layout = load_layout(dir + "ellipsoid.layout.json", mesh);
   no.orientation_at_end = false;
   no.stiffen_at_end = false;

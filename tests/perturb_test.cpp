@@ -124,7 +124,7 @@ TEST(Perturb, RealSpotRefined) {
   QuadImportOptions io;
   io.refine = 3;
   const QuadImportResult r =
-      import_quads(load_poly_mesh(dir + "/spot/spot_quadrangulated.obj"), nullptr, io);
+      import_quads(test::load_poly_mesh(dir + "/spot/spot_quadrangulated.obj"), nullptr, io);
   PerturbLayoutOptions options;
   options.rings = 2;
   options.seed = 1;

@@ -1,7 +1,7 @@
 // The rules of optimize's retries (core/nodeopt/retry.h) on results made to order: each branch,
 // including those that real models reach only on some machines (a run that falls back to its
 // initial state: the exact cow and cat, or the displaced spot with nodes kept apart on an AMD
-// EPYC but not on an Intel Xeon). The retries' runs themselves: sizing_retry_cli_test.cpp.
+// EPYC but not on an Intel Xeon). Real runs: rocker_arm_cli_test.cpp.
 #include "core/nodeopt/retry.h"
 
 #include <gtest/gtest.h>

@@ -161,7 +161,7 @@ TEST(Robustness, NearlyDegenerateFaces) {
 TEST(Robustness, BlockSliversGiveFiniteGeometryAndCurvature) {
   const std::string dir = test::shared_meshes_dir();
   if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes is absent";
-  const TriMesh mesh = load_mesh(dir + "/block.off");
+  const TriMesh mesh = test::load_mesh(dir + "/block.off");
   const GeometryCache g = build_geometry(mesh);
   int below_1deg = 0;
   for (double a : g.corner_angle) {
