@@ -107,6 +107,16 @@ TEST(WorkingMesh, TwoPointsInOneInputTriangleAreBothInserted) {
   EXPECT_NE(i3.vertex, i2.vertex);
   EXPECT_LE((wm.mesh().point(VH(i3.vertex)) - wm.position(close)).norm(),
             wm.options().snap * 1e-3 * diagonal(*input) + 1e-12);
+  // Barycentrics that sum to 1 only within the files' tolerance are normalized: the vertex lies
+  // on the input face's plane.
+  const auto loose = wm.insert_point(SurfacePoint{f, {{0.3333333, 0.3333333, 0.3333333}}});
+  EXPECT_TRUE(loose.created && loose.exact);
+  const SurfacePoint& o = wm.origin(loose.vertex);
+  EXPECT_NEAR(o.bary[0] + o.bary[1] + o.bary[2], 1, 1e-15);
+  EXPECT_LE(
+      (wm.mesh().point(VH(loose.vertex)) - from_bary(*input, f, {{1.0 / 3, 1.0 / 3, 1.0 / 3}}))
+          .norm(),
+      1e-15 * diagonal(*input));
   // The same point again reuses the vertex exactly.
   const auto again = wm.insert_point(SurfacePoint{f, {{0.2, 0.3, 0.5}}});
   EXPECT_EQ(again.vertex, i1.vertex);
@@ -434,7 +444,7 @@ TEST(WorkingMesh, RejectsBadArgumentsNamingTheElement) {
   }
   EXPECT_TRUE(names(error_of([&] { wm.split_edge(-1, 0.5); }), "edge -1"));
   EXPECT_TRUE(names(error_of([&] { wm.split_edge(1 << 20, 0.5); }), "edge 1048576"));
-  for (Bary b : {Bary{0, 0.5, 0.5}, Bary{1.2, -0.1, -0.1}, Bary{0.5, 0.5, 0.5},
+  for (Bary b : {Bary{0, 0.5, 0.5}, Bary{1.2, -0.1, -0.1}, Bary{0.5, 0.5, 0.5}, Bary{0.3, 0.3, 0.3},
                  Bary{std::nan(""), 0.5, 0.5}}) {
     EXPECT_TRUE(names(error_of([&] { wm.split_face(9, b); }), "face 9"));
   }

@@ -154,18 +154,21 @@ SurfacePoint WorkingMesh::checked_point(const SurfacePoint& p, const char* what)
                             " out of range (the input has " + std::to_string(input_->n_faces()) +
                             " faces)");
   }
-  double sum = 0;
+  // The tolerances of the layout files' points (routing's snap_to_vertex).
   bool ok = true;
-  for (double b : p.bary) {
-    ok = ok && std::isfinite(b) && b >= -1e-12;
-    sum += b;
-  }
-  if (!ok || !(std::abs(sum - 1) <= 1e-9)) {
+  for (double b : p.bary) ok = ok && std::isfinite(b) && b >= -1e-9;
+  SurfacePoint out = p;
+  double sum = 0;
+  for (double& b : out.bary) sum += (b = std::max(b, 0.0));
+  if (!ok || !(std::abs(sum - 1) <= 1e-6)) {
     throw InvalidInputError(std::string(what) + ": barycentrics " + bary_text(p.bary) +
                             " are outside input face " + std::to_string(p.face));
   }
-  SurfacePoint out = p;
-  for (double& b : out.bary) b = std::max(b, 0.0);
+  // An affine combination up to rounding, so that the point lies on the face's plane; zeros
+  // stay zeros. Weights that already sum to 1 up to rounding are kept bit for bit.
+  if (std::abs(sum - 1) > 1e-12) {
+    for (double& b : out.bary) b /= sum;
+  }
   return out;
 }
 
@@ -493,11 +496,13 @@ int WorkingMesh::split_face(int face, const std::array<double, 3>& bary) {
   check_face(face, "split_face");
   const double sum = bary[0] + bary[1] + bary[2];
   if (!(bary[0] > 0 && bary[1] > 0 && bary[2] > 0) || !std::isfinite(sum) ||
-      !(std::abs(sum - 1) <= 1e-9)) {
+      !(std::abs(sum - 1) <= 1e-6)) {
     throw InvalidInputError("split_face: barycentrics " + bary_text(bary) +
                             " are not strictly inside working-mesh face " + std::to_string(face));
   }
-  Candidate c = face_split_candidate(face, face_point(face, bary));
+  const double scale = std::abs(sum - 1) > 1e-12 ? 1 / sum : 1.0;
+  const Bary normalized{bary[0] * scale, bary[1] * scale, bary[2] * scale};
+  Candidate c = face_split_candidate(face, face_point(face, normalized));
   if (!evaluate(c)) {
     throw InvalidInputError("split_face: barycentrics " + bary_text(bary) +
                             " are too close to an edge of working-mesh face " +

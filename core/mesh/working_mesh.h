@@ -46,7 +46,9 @@ void validate_working_mesh_options(const WorkingMeshOptions& options);
 //!
 //! Indices: editing never changes the index of an existing vertex, face or edge (removed
 //! elements are only marked deleted until compact()). Face-vertex order of an edited face may
-//! rotate. Location results are valid until the next edit.
+//! rotate. Location results, and the references origin() and hosted_faces() return, are valid
+//! until the next edit. locate() and insert_point() scan the W faces of one host: O(number of
+//! W faces in that input face).
 //!
 //! Errors: element indices out of range or deleted, parameters outside the element (t outside
 //! (0,1), barycentrics outside the face or not summing to 1) throw InvalidInputError naming the
@@ -86,8 +88,11 @@ class WorkingMesh {
     int face = -1;
     std::array<double, 3> bary{};
   };
+  //! Points given to locate, insert_point and move_vertex are normalized first: components
+  //! in [-1e-9, 0) are clamped to 0, and all are divided by their sum when it is more than 1e-12
+  //! from 1 (an exact 0 stays 0).
   //! \throw InvalidInputError if p's face is out of range or its barycentrics are outside the
-  //! face (a component below -1e-12, non-finite, or a sum more than 1e-9 from 1).
+  //! face (a component below -1e-9, non-finite, or a sum more than 1e-6 from 1).
   Location locate(const SurfacePoint& p) const;
   //! Barycentrics of W vertex v in input face f (v must lie on f's closure, else nullopt).
   std::optional<std::array<double, 3>> bary_in_input_face(int v, int input_face) const;
@@ -112,13 +117,13 @@ class WorkingMesh {
   //! would not be positively oriented (t too close to 0 or 1 to separate the vertices).
   int split_edge(int edge, double t);
   //! 1→3 split at barycentrics \p bary w.r.t. the face's corners (face-vertex order); returns
-  //! the new vertex. \throw InvalidInputError if the face is invalid, or bary has a component
-  //! <= 0, is non-finite or does not sum to 1 within 1e-9 (points on edges: split_edge), or a
-  //! new triangle would not be positively oriented.
+  //! the new vertex (bary is normalized like a point, see locate). \throw InvalidInputError if the
+  //! face is invalid, or bary has a component <= 0, is non-finite or does not sum to 1 within 1e-6
+  //! (points on edges: split_edge), or a new triangle would not be positively oriented.
   int split_face(int face, const std::array<double, 3>& bary);
 
   //! Result of insert_point: the vertex at (or near) p, whether it lies exactly at p (origin
-  //! equal to p in p's face), and whether it was created.
+  //! equal to the normalized p in p's face), and whether it was created.
   struct Inserted {
     int vertex = -1;
     bool exact = true;
@@ -154,15 +159,16 @@ class WorkingMesh {
   //! least min_angle_deg or at least the star's smallest angle before the move.
   //! \throw InvalidInputError for an invalid vertex or point.
   bool can_move_vertex(int v, const SurfacePoint& p) const;
-  //! Moves v to p (origin = p) when can_move_vertex allows it; false: nothing changed.
+  //! Moves v to p (origin = the normalized p) when can_move_vertex allows it; false: nothing
+  //! changed.
   bool move_vertex(int v, const SurfacePoint& p);
 
   //! Removes a refinement vertex by collapsing it into a neighbour u such that every remaining
   //! triangle of its star stays in its host and positively oriented: for a vertex interior to
   //! its host any neighbour, for a vertex on an input edge a neighbour on the same closed input
   //! edge. Among valid neighbours, the one giving the largest smallest angle is chosen. False
-  //! (nothing changed) when v is an input vertex or no collapse is valid. Marks the vertex, two
-  //! faces (one on the boundary) and their edges deleted; call compact() afterwards.
+  //! (nothing changed) when v is an input vertex or no collapse is valid. Marks v, the faces
+  //! beside edge (v, u) and the edges merged away deleted; call compact() afterwards.
   bool remove_vertex(int v);
 
   //! Maps from old to new indices (-1 for removed elements): vertex (size #V before), edge
@@ -213,12 +219,12 @@ class WorkingMesh {
   static int zero_count(const Bary& b);
 
   std::array<int, 3> corners(int f) const;
-  std::array<int, 3> input_corners(int input_face) const { return input_corners_[input_face]; }
   Bary host_bary(int v, int host) const;            // bary_in_input_face that must succeed
   Location locate_in(const SurfacePoint& p) const;  // p already checked
 
-  // Triangles (corner indices into a small vertex table) created by a hypothetical edit, with
-  // their host; evaluated without changing W.
+  // A hypothetical split: the new vertex's origin, the triangles it would create (W vertex
+  // indices, -1 for the new vertex) with their hosts, and the faces it replaces; evaluated
+  // without changing W.
   struct Candidate;
   bool evaluate(Candidate& c) const;
   Candidate edge_split_candidate(int edge, const SurfacePoint& o) const;
