@@ -8,6 +8,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <numeric>
 #include <set>
 #include <sstream>
 
@@ -338,11 +339,177 @@ TEST(QuadMesh, ExportsAreReadableAndConsistent) {
       EXPECT_LT((Vec3(b[0], b[1], b[2]) - x1).norm(), tol);
     }
   }
-  // layout_curves.obj: one polyline per arc.
+  // layout_curves.obj: one group per arc (checked in detail by LayoutCurves.* below).
   std::ifstream curves(dir + "/layout_curves.obj");
-  int polylines = 0;
-  while (std::getline(curves, line)) polylines += line.rfind("l ", 0) == 0;
-  EXPECT_EQ(polylines, r.pipeline->topology().num_arcs);
+  int arc_groups = 0;
+  while (std::getline(curves, line)) arc_groups += line.rfind("g arc_", 0) == 0;
+  EXPECT_EQ(arc_groups, r.pipeline->topology().num_arcs);
+}
+
+// An OBJ reader written for these tests, independent of the writers: vertices, texture
+// coordinates, and per group (g) its line segments (an `l` of k vertices is k − 1 segments) and
+// faces as (v, vt) corners. Indices 0-based; negative (relative) indices resolved.
+struct ObjGroup {
+  std::vector<std::array<long, 2>> segments;
+  std::vector<int> line_sizes;  //!< vertices per `l` record
+  std::vector<std::vector<std::array<long, 2>>> faces;
+};
+struct ObjFile {
+  std::vector<std::array<double, 3>> v;
+  std::vector<std::array<double, 2>> vt;
+  std::vector<std::string> group_order;
+  std::map<std::string, ObjGroup> groups;
+};
+ObjFile read_obj_independently(const std::string& path) {
+  ObjFile obj;
+  std::ifstream in(path);
+  EXPECT_TRUE(in) << path;
+  std::string line, tag, group = "default";
+  auto resolve = [](long i, size_t count) { return i > 0 ? i - 1 : static_cast<long>(count) + i; };
+  while (std::getline(in, line)) {
+    std::istringstream ss(line);
+    if (!(ss >> tag) || tag[0] == '#') continue;
+    if (tag == "v") {
+      std::array<double, 3> x{};
+      ss >> x[0] >> x[1] >> x[2];
+      obj.v.push_back(x);
+    } else if (tag == "vt") {
+      std::array<double, 2> t{};
+      ss >> t[0] >> t[1];
+      obj.vt.push_back(t);
+    } else if (tag == "g" || tag == "o") {
+      if (tag == "o") continue;  // one object per file here; groups name the parts
+      ss >> group;
+      if (!obj.groups.count(group)) obj.group_order.push_back(group);
+      obj.groups[group];
+    } else if (tag == "l" || tag == "f") {
+      std::vector<std::array<long, 2>> corners;
+      std::string c;
+      while (ss >> c) {
+        const size_t slash = c.find('/');
+        const long vi = resolve(std::stol(c.substr(0, slash)), obj.v.size());
+        long ti = -1;
+        if (slash != std::string::npos && slash + 1 < c.size() && c[slash + 1] != '/')
+          ti = resolve(std::stol(c.substr(slash + 1)), obj.vt.size());
+        corners.push_back({vi, ti});
+      }
+      ObjGroup& g = obj.groups[group];
+      if (tag == "l") {
+        g.line_sizes.push_back(static_cast<int>(corners.size()));
+        for (size_t i = 0; i + 1 < corners.size(); ++i)
+          g.segments.push_back({corners[i][0], corners[i + 1][0]});
+      } else {
+        g.faces.push_back(std::move(corners));
+      }
+    }
+  }
+  return obj;
+}
+
+double dist(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+}
+
+// The layout_curves.obj checks: every arc's group is a chain of 2-vertex line records along its
+// traced polyline, the edges of all groups are Σ (points − 1), and an arc's end vertices are its
+// nodes' vertices, one per node, shared by all arcs there (none for ends off a node).
+void expect_layout_curves(const std::string& path, const Layout& layout, const Extraction& ex,
+                          double tol) {
+  const ObjFile obj = read_obj_independently(path);
+  long want_edges = 0, got_edges = 0;
+  for (const auto& t : ex.arcs)
+    if (t.polyline.size() >= 2) want_edges += static_cast<long>(t.polyline.size()) - 1;
+  for (const auto& [name, g] : obj.groups) {
+    got_edges += static_cast<long>(g.segments.size());
+    for (int n : g.line_sizes)
+      EXPECT_EQ(n, 2) << name << ": an `l` record with " << n << " vertices";
+  }
+  EXPECT_EQ(got_edges, want_edges) << "line segments in " << path;
+  std::map<int, std::set<long>> node_vertices;  // node index → vertex indices at its arc ends
+  std::set<long> end_vertices_off_nodes;
+  for (size_t a = 0; a < ex.arcs.size(); ++a) {
+    const auto& poly = ex.arcs[a].polyline;
+    const std::string name = "arc_" + std::to_string(layout.arcs[a].id);
+    ASSERT_TRUE(obj.groups.count(name)) << name;
+    const auto& seg = obj.groups.at(name).segments;
+    ASSERT_EQ(seg.size() + 1, poly.size()) << name;
+    for (size_t i = 0; i < seg.size(); ++i) {
+      ASSERT_GE(seg[i][0], 0);
+      ASSERT_GE(seg[i][1], 0);
+      ASSERT_LT(seg[i][0], static_cast<long>(obj.v.size()));
+      ASSERT_LT(seg[i][1], static_cast<long>(obj.v.size()));
+      if (i + 1 < seg.size()) {
+        EXPECT_EQ(seg[i][1], seg[i + 1][0]) << name << " is not a chain";
+      }
+      EXPECT_LT(dist(obj.v[seg[i][0]], poly[i]), tol) << name << " point " << i;
+    }
+    EXPECT_LT(dist(obj.v[seg.back()[1]], poly.back()), tol) << name << " end";
+    node_vertices[layout.node_index(layout.arcs[a].from)].insert(seg.front()[0]);
+    if (layout.arcs[a].to >= 0 && ex.arcs[a].ok)
+      node_vertices[layout.node_index(layout.arcs[a].to)].insert(seg.back()[1]);
+    else
+      end_vertices_off_nodes.insert(seg.back()[1]);
+  }
+  std::set<long> all_node_vertices;
+  for (const auto& [node, vs] : node_vertices) {
+    EXPECT_EQ(vs.size(), 1u) << "node " << layout.nodes[node].id << " has " << vs.size()
+                             << " vertices";
+    all_node_vertices.insert(vs.begin(), vs.end());
+  }
+  EXPECT_EQ(all_node_vertices.size(), node_vertices.size()) << "two nodes share a vertex";
+  for (long v : end_vertices_off_nodes)
+    EXPECT_FALSE(all_node_vertices.count(v)) << "an arc end off its node uses a node vertex";
+  // The node group lists the node vertices.
+  ASSERT_TRUE(obj.groups.count("nodes") || node_vertices.empty());
+}
+
+// Connected pieces of the curve network (vertices joined by segments).
+int curve_pieces(const ObjFile& obj) {
+  std::vector<long> parent(obj.v.size());
+  std::iota(parent.begin(), parent.end(), 0L);
+  auto find = [&](long x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  std::set<long> used;
+  for (const auto& [name, g] : obj.groups)
+    for (const auto& s : g.segments) {
+      parent[find(s[0])] = find(s[1]);
+      used.insert(s[0]);
+      used.insert(s[1]);
+    }
+  std::set<long> roots;
+  for (long v : used) roots.insert(find(v));
+  return static_cast<int>(roots.size());
+}
+
+TEST(LayoutCurves, ArcsAreTwoVertexLinesSharingNodeVertices) {
+  QuadMeshOptions opt;
+  opt.quad_size = 0.25;
+  const QuadRun r = run_quads(test::cube_sphere(8), opt);
+  const std::string dir = test::temp_dir("layout_curves");
+  const Layout layout = r.pipeline->output_layout();
+  write_layout_curves_obj(layout, r.extraction, dir + "/layout_curves.obj");
+  const double tol = 1e-9 * r.pipeline->geometry().bbox_diagonal;
+  expect_layout_curves(dir + "/layout_curves.obj", layout, r.extraction, tol);
+  // The cube's 12 arcs between 8 nodes make one connected network.
+  const ObjFile obj = read_obj_independently(dir + "/layout_curves.obj");
+  EXPECT_EQ(curve_pieces(obj), 1);
+  EXPECT_EQ(obj.groups.at("nodes").segments.size(), 0u);
+}
+
+TEST(LayoutCurves, FailedArcEndsOnItsOwnVertex) {
+  QuadMeshOptions opt;
+  opt.quad_size = 0.25;
+  QuadRun r = run_quads(test::cube_sphere(6), opt);
+  // Arc 0 stopped short of its end node: its end is a vertex of its own.
+  r.extraction.arcs[0].ok = false;
+  r.extraction.arcs[0].polyline.pop_back();
+  const std::string dir = test::temp_dir("layout_curves_failed");
+  const Layout layout = r.pipeline->output_layout();
+  write_layout_curves_obj(layout, r.extraction, dir + "/layout_curves.obj");
+  expect_layout_curves(dir + "/layout_curves.obj", layout, r.extraction,
+                       1e-9 * r.pipeline->geometry().bbox_diagonal);
 }
 
 TEST(QuadMesh, CliWritesQuadFiles) {
@@ -363,6 +530,155 @@ TEST(QuadMesh, CliWritesQuadFiles) {
   const PolyMesh pm = load_poly_mesh(dir + "/out/quads.obj");
   EXPECT_GT(pm.n_faces(), 75u);
   EXPECT_LT(pm.n_faces(), 300u);
+}
+
+// Per group patch_<id> of a quads.obj: the bounding box of its texture coordinates and its
+// faces as UV quads.
+struct UvPatch {
+  std::array<double, 4> box{1e300, 1e300, -1e300, -1e300};  //!< u0, v0, u1, v1
+  std::vector<std::array<std::array<double, 2>, 4>> quads;
+};
+std::map<int, UvPatch> uv_patches(const ObjFile& obj) {
+  std::map<int, UvPatch> out;
+  for (const auto& [name, g] : obj.groups) {
+    if (name.rfind("patch_", 0) != 0) continue;
+    UvPatch& p = out[std::stoi(name.substr(6))];
+    for (const auto& f : g.faces) {
+      EXPECT_EQ(f.size(), 4u);
+      std::array<std::array<double, 2>, 4> q{};
+      for (size_t c = 0; c < 4 && c < f.size(); ++c) {
+        EXPECT_GE(f[c][1], 0) << name << ": a corner without vt";
+        if (f[c][1] < 0) continue;
+        q[c] = obj.vt[f[c][1]];
+        p.box = {std::min(p.box[0], q[c][0]), std::min(p.box[1], q[c][1]),
+                 std::max(p.box[2], q[c][0]), std::max(p.box[3], q[c][1])};
+      }
+      p.quads.push_back(q);
+    }
+  }
+  return out;
+}
+
+// Whether two UV triangles overlap with positive area (separating axis test: no edge normal
+// of either triangle separates them by more than eps).
+using Tri2 = std::array<std::array<double, 2>, 3>;
+bool triangles_overlap(const Tri2& a, const Tri2& b, double eps = 1e-12) {
+  for (const Tri2* t : {&a, &b})
+    for (int e = 0; e < 3; ++e) {
+      const auto& p = (*t)[e];
+      const auto& q = (*t)[(e + 1) % 3];
+      const double nx = q[1] - p[1], ny = p[0] - q[0];
+      double amin = 1e300, amax = -1e300, bmin = 1e300, bmax = -1e300;
+      for (const auto& x : a) {
+        const double d = nx * x[0] + ny * x[1];
+        amin = std::min(amin, d), amax = std::max(amax, d);
+      }
+      for (const auto& x : b) {
+        const double d = nx * x[0] + ny * x[1];
+        bmin = std::min(bmin, d), bmax = std::max(bmax, d);
+      }
+      const double scale = std::max(std::hypot(nx, ny), 1e-300);
+      if (amax <= bmin + eps * scale || bmax <= amin + eps * scale) return false;
+    }
+  return true;
+}
+
+// Pairs of faces of different patches whose UV triangles overlap, over up to `per_patch` quads
+// of each patch (spread over the patch).
+int overlapping_uv_faces(const std::map<int, UvPatch>& patches, size_t per_patch) {
+  std::vector<std::pair<int, Tri2>> tris;
+  for (const auto& [id, p] : patches) {
+    const size_t stride = std::max<size_t>(1, p.quads.size() / per_patch);
+    for (size_t k = 0; k < p.quads.size(); k += stride) {
+      const auto& q = p.quads[k];
+      tris.push_back({id, Tri2{q[0], q[1], q[2]}});
+      tris.push_back({id, Tri2{q[0], q[2], q[3]}});
+    }
+  }
+  int overlaps = 0;
+  for (size_t i = 0; i < tris.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      overlaps +=
+          tris[i].first != tris[j].first && triangles_overlap(tris[i].second, tris[j].second);
+  return overlaps;
+}
+
+TEST(QuadsObj, PackedAtlasIsNonOverlappingAspectCorrectAndUniform) {
+  QuadMeshOptions opt;
+  opt.quad_size = 0.15;
+  const QuadRun r = run_quads(test::cube_sphere(10, Vec3(1.5, 1.0, 0.7)), opt);
+  const QuadMesh& qm = r.quads;
+  ASSERT_EQ(qm.gridded_patches(), 6);
+  const std::string dir = test::temp_dir("quads_atlas");
+  write_quads_obj(qm, dir + "/per_patch.obj");
+  UvAtlasOptions packed;
+  packed.layout = UvAtlasLayout::kPacked;
+  write_quads_obj(qm, dir + "/packed.obj", packed);
+  const ObjFile a = read_obj_independently(dir + "/per_patch.obj");
+  const ObjFile b = read_obj_independently(dir + "/packed.obj");
+  ASSERT_EQ(a.vt.size(), b.vt.size());
+  const auto pa = uv_patches(a), pb = uv_patches(b);
+  ASSERT_EQ(pb.size(), 6u);
+  // The per-patch layout: every patch on [0,1]², so the patches overlap (the check can fail).
+  for (const auto& [id, p] : pa) EXPECT_EQ(p.box, (std::array<double, 4>{0, 0, 1, 1})) << id;
+  EXPECT_GT(overlapping_uv_faces(pa, 40), 0);
+  // Packed: inside [0,1]², aspect w/h, one scale, disjoint rectangles a gutter apart.
+  for (const auto& t : b.vt) {
+    EXPECT_GE(std::min(t[0], t[1]), 0.0);
+    EXPECT_LE(std::max(t[0], t[1]), 1.0);
+  }
+  std::set<double> aspects;
+  double scale = 0, area = 0;
+  for (const auto& [id, p] : pb) {
+    const auto& size = qm.patches[id].size;
+    const double du = p.box[2] - p.box[0], dv = p.box[3] - p.box[1];
+    ASSERT_GT(du, 0);
+    ASSERT_GT(dv, 0);
+    EXPECT_NEAR(du / dv, size[0] / size[1], 1e-9 * size[0] / size[1]) << "patch " << id;
+    if (scale == 0) scale = du / size[0];
+    EXPECT_NEAR(du / size[0], scale, 1e-9 * scale) << "patch " << id;
+    EXPECT_NEAR(dv / size[1], scale, 1e-9 * scale) << "patch " << id;
+    aspects.insert(std::round(size[0] / size[1] * 1e6));
+    area += du * dv;
+  }
+  EXPECT_GT(aspects.size(), 1u) << "the test needs patches of different aspect ratios";
+  EXPECT_GT(area, 0.5) << "the atlas should use most of [0,1]²";
+  for (auto i = pb.begin(); i != pb.end(); ++i)
+    for (auto j = std::next(i); j != pb.end(); ++j) {
+      const auto &x = i->second.box, &y = j->second.box;
+      const double gap = std::max({y[0] - x[2], x[0] - y[2], y[1] - x[3], x[1] - y[3]});
+      EXPECT_GE(gap, packed.gutter - 1e-12) << "patches " << i->first << " and " << j->first;
+    }
+  EXPECT_EQ(overlapping_uv_faces(pb, 40), 0);
+  // The same patch coordinates: packed = rectangle corner + per-patch coordinate · extent.
+  for (const auto& [id, p] : pb) {
+    const auto& g = b.groups.at("patch_" + std::to_string(id));
+    for (const auto& f : g.faces)
+      for (const auto& c : f) {
+        const auto &t = b.vt[c[1]], &s = a.vt[c[1]];
+        EXPECT_NEAR(t[0], p.box[0] + s[0] * (p.box[2] - p.box[0]), 1e-12);
+        EXPECT_NEAR(t[1], p.box[1] + s[1] * (p.box[3] - p.box[1]), 1e-12);
+      }
+  }
+}
+
+TEST(QuadsObj, CliPackedAtlas) {
+  const std::string dir = test::temp_dir("quads_cli_atlas");
+  const auto in = test::cube_sphere(6, Vec3(1.4, 1.0, 0.8));
+  test::write_obj(in.mesh, dir + "/m.obj");
+  save_layout(in.layout, dir + "/m.layout.json", &in.mesh);
+  const std::string base = test::cli_path() + " -q optimize --mesh " + dir + "/m.obj --layout " +
+                           dir + "/m.layout.json --out " + dir + "/out --no-node-opt";
+  std::string out;
+  ASSERT_EQ(test::run_command(base + " --quad-count 150 --atlas packed", &out), 0) << out;
+  const auto patches = uv_patches(read_obj_independently(dir + "/out/quads.obj"));
+  EXPECT_EQ(patches.size(), 6u);
+  EXPECT_EQ(overlapping_uv_faces(patches, 1000), 0);
+  // Without a quad mesh the option has nothing to act on; an unknown layout is refused.
+  EXPECT_NE(test::run_command(base + " --atlas packed", &out), 0);
+  EXPECT_NE(out.find("--atlas"), std::string::npos) << out;
+  EXPECT_NE(test::run_command(base + " --quad-count 150 --atlas tiles", &out), 0);
+  EXPECT_NE(out.find("--atlas"), std::string::npos) << out;
 }
 
 }  // namespace

@@ -85,6 +85,12 @@ int main(int argc, char** argv) {
                     "Make every patch size an integer multiple of the quad size: optimize relaxed, "
                     "round the arc lengths, optimize again with them fixed (needs --quad-size or "
                     "--quad-count)");
+  cmd_opt
+      ->add_option("--atlas", opt.atlas,
+                   "Texture coordinates of quads.obj: per-patch (every patch on [0,1]^2) or packed "
+                   "(non-overlapping patches, one scale, for baking)")
+      ->check(CLI::IsMember({"per-patch", "packed"}))
+      ->capture_default_str();
   cmd_opt->add_option("--gradient", opt.gradient, "Node gradient: estimator or exact")
       ->check(CLI::IsMember({"estimator", "exact"}))
       ->capture_default_str();

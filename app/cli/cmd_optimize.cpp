@@ -99,6 +99,8 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     if (o.sizing) options.param.sizing.enabled = *o.sizing;
     if (o.integer && !(o.quad_size > 0 || o.quad_count > 0))
       throw InvalidInputError("--integer needs --quad-size Q or --quad-count N");
+    if (o.atlas != "per-patch" && !(o.quad_size > 0 || o.quad_count > 0))
+      throw InvalidInputError("--atlas needs --quad-size Q or --quad-count N");
     if (o.orientation && !o.no_node_opt)
       throw InvalidInputError(
           "--orientation applies to --no-node-opt runs (the node optimization removes "
@@ -460,7 +462,9 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       qo.quad_size = integer ? integer->quad_size : o.quad_size;
       qo.quad_count = integer ? 0 : o.quad_count;
       const QuadMesh quads = build_quad_mesh(pipeline, ex, qo);
-      write_quad_exports(quads, pipeline.output_layout(), ex, out.string());
+      UvAtlasOptions atlas;
+      if (o.atlas == "packed") atlas.layout = UvAtlasLayout::kPacked;
+      write_quad_exports(quads, pipeline.output_layout(), ex, out.string(), atlas);
       report["quads"] = {{"quad_size", quads.quad_size},
                          {"vertices", quads.vertices.size()},
                          {"quads", quads.quads.size()},

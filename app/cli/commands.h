@@ -32,6 +32,8 @@ struct OptimizeOptions {
   int quad_count = 0;    //!< alternative to quad_size: about this many quads
   bool integer = false;  //!< patch sizes integer multiples of the quad size (paper §8)
   std::string gradient = "estimator";
+  //! quads.obj texture coordinates: "per-patch" or "packed" (UvAtlasLayout)
+  std::string atlas = "per-patch";
   bool no_align = false;
   bool discrete_relocation = false;
   bool no_orientation = false;  //!< no orientation constraints after the node optimization

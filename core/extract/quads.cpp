@@ -280,19 +280,31 @@ QuadMesh build_quad_mesh(const Pipeline& pipeline, const Extraction& extraction,
                          pipeline.parameterization()->corner_uv, options);
 }
 
-void write_quads_obj(const QuadMesh& qm, const std::string& path) {
+void write_quads_obj(const QuadMesh& qm, const std::string& path, const UvAtlasOptions& atlas) {
+  std::vector<std::array<double, 2>> sizes;
+  for (const auto& qp : qm.patches)
+    if (qp.ok) sizes.push_back(qp.size);
+  const std::vector<UvRect> rects = uv_atlas(sizes, atlas);
   write_file_atomic(path, [&](std::ostream& out) {
     out << "# QuadSketch quad mesh: " << qm.vertices.size() << " vertices, " << qm.quads.size()
         << " quads, " << qm.gridded_patches() << " patches, quad size " << qm.quad_size << "\n";
-    out << "# vt: normalized patch coordinates (s/w, t/h) per face corner\n";
+    if (atlas.layout == UvAtlasLayout::kPacked)
+      out << "# vt: packed atlas, patch coordinates (s, t) scaled by one factor for all patches,"
+             " non-overlapping rectangles in [0,1]^2\n";
+    else
+      out << "# vt: normalized patch coordinates (s/w, t/h) per face corner\n";
     for (const auto& v : qm.vertices) out << fmt3("v", v);
     char line[96];
+    size_t k = 0;
     for (const auto& qp : qm.patches) {
       if (!qp.ok) continue;
+      const UvRect& r = rects[k++];
       for (int j = 0; j <= qp.grid[1]; ++j)
         for (int i = 0; i <= qp.grid[0]; ++i) {
-          std::snprintf(line, sizeof line, "vt %.17g %.17g\n", static_cast<double>(i) / qp.grid[0],
-                        static_cast<double>(j) / qp.grid[1]);
+          const double s = static_cast<double>(i) / qp.grid[0];
+          const double t = static_cast<double>(j) / qp.grid[1];
+          std::snprintf(line, sizeof line, "vt %.17g %.17g\n", r.u0 + s * (r.u1 - r.u0),
+                        r.v0 + t * (r.v1 - r.v0));
           out << line;
         }
     }
@@ -362,49 +374,73 @@ void write_patches_json(const QuadMesh& qm, const Layout& layout, const Extracti
 }
 
 void write_layout_curves_obj(const Layout& layout, const Extraction& ex, const std::string& path) {
+  const size_t num_arcs = ex.arcs.size();
+  // Node positions: the start of an arc from the node, or the end of a traced arc to it.
+  std::vector<const P3*> node_x(layout.nodes.size(), nullptr);
+  auto from_node = [&](size_t a) { return layout.node_index(layout.arcs[a].from); };
+  auto to_node = [&](size_t a) {
+    return layout.arcs[a].to >= 0 && ex.arcs[a].ok ? layout.node_index(layout.arcs[a].to) : -1;
+  };
+  for (size_t a = 0; a < num_arcs; ++a) {
+    const auto& poly = ex.arcs[a].polyline;
+    if (poly.empty()) continue;
+    const int from = from_node(a), to = to_node(a);
+    if (from >= 0 && !node_x[from]) node_x[from] = &poly.front();
+    if (to >= 0 && !node_x[to]) node_x[to] = &poly.back();
+  }
+  // OBJ vertex indices (1-based): the nodes first, then each arc's own vertices.
+  std::vector<const P3*> vertices;
+  std::vector<long> node_v(layout.nodes.size(), 0);
+  for (size_t n = 0; n < node_x.size(); ++n)
+    if (node_x[n]) {
+      vertices.push_back(node_x[n]);
+      node_v[n] = static_cast<long>(vertices.size());
+    }
+  const size_t num_nodes = vertices.size();
+  std::vector<std::vector<long>> arc_v(num_arcs);  // per arc: one index per polyline point
+  for (size_t a = 0; a < num_arcs; ++a) {
+    const auto& poly = ex.arcs[a].polyline;
+    if (poly.size() < 2) continue;
+    const int from = from_node(a), to = to_node(a);
+    auto& idx = arc_v[a];
+    for (size_t i = 0; i < poly.size(); ++i) {
+      const bool first = i == 0, last = i + 1 == poly.size();
+      if (first && from >= 0) {
+        idx.push_back(node_v[from]);
+      } else if (last && to >= 0) {
+        idx.push_back(node_v[to]);
+      } else {
+        vertices.push_back(&poly[i]);
+        idx.push_back(static_cast<long>(vertices.size()));
+      }
+    }
+  }
   write_file_atomic(path, [&](std::ostream& out) {
-    out << "# QuadSketch layout: traced arcs as polylines (l), nodes as points (p)\n";
+    out << "# QuadSketch layout: nodes and traced arcs. Vertices 1.." << num_nodes
+        << " are the nodes, shared by the arcs that end there; then the arcs' inner points.\n"
+        << "# Group arc_<id>: that arc's polyline from its from node to its to node, one\n"
+        << "# 2-vertex line (l) per segment. Group nodes: the node vertices as points (p).\n";
     out << "o layout_curves\n";
-    std::vector<long> first(ex.arcs.size(), 0);
-    long next = 1;
-    for (size_t a = 0; a < ex.arcs.size(); ++a) {
-      first[a] = next;
-      for (const auto& x : ex.arcs[a].polyline) out << fmt3("v", x);
-      next += static_cast<long>(ex.arcs[a].polyline.size());
+    for (const P3* x : vertices) out << fmt3("v", *x);
+    for (size_t a = 0; a < num_arcs; ++a) {
+      const auto& idx = arc_v[a];
+      if (idx.empty()) continue;
+      out << "g arc_" << layout.arcs[a].id << '\n';
+      for (size_t i = 0; i + 1 < idx.size(); ++i)
+        out << "l " << idx[i] << ' ' << idx[i + 1] << '\n';
     }
-    // Node positions: the end points of their arcs.
-    std::vector<long> node_v(layout.nodes.size(), 0);
-    for (size_t a = 0; a < ex.arcs.size(); ++a) {
-      const auto& t = ex.arcs[a];
-      if (t.polyline.empty()) continue;
-      const int from = layout.node_index(layout.arcs[a].from);
-      const int to = layout.arcs[a].to >= 0 ? layout.node_index(layout.arcs[a].to) : -1;
-      if (from >= 0 && node_v[from] == 0) node_v[from] = first[a];
-      if (to >= 0 && t.ok && node_v[to] == 0)
-        node_v[to] = first[a] + static_cast<long>(t.polyline.size()) - 1;
-    }
-    for (size_t a = 0; a < ex.arcs.size(); ++a) {
-      const size_t n = ex.arcs[a].polyline.size();
-      if (n < 2) continue;
-      out << "g arc_" << layout.arcs[a].id << "\nl";
-      for (size_t i = 0; i < n; ++i) out << ' ' << first[a] + static_cast<long>(i);
-      out << '\n';
-    }
-    bool any = false;
-    for (long v : node_v) any |= v > 0;
-    if (any) {
+    if (num_nodes > 0) {
       out << "g nodes\np";
-      for (long v : node_v)
-        if (v > 0) out << ' ' << v;
+      for (size_t v = 1; v <= num_nodes; ++v) out << ' ' << v;
       out << '\n';
     }
   });
 }
 
 void write_quad_exports(const QuadMesh& qm, const Layout& layout, const Extraction& ex,
-                        const std::string& dir) {
+                        const std::string& dir, const UvAtlasOptions& atlas) {
   const std::filesystem::path d(dir);
-  write_quads_obj(qm, (d / "quads.obj").string());
+  write_quads_obj(qm, (d / "quads.obj").string(), atlas);
   write_patches_json(qm, layout, ex, (d / "patches.json").string());
   write_layout_curves_obj(layout, ex, (d / "layout_curves.obj").string());
 }

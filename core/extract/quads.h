@@ -10,6 +10,7 @@
 
 #include "core/extract/patches.h"
 #include "core/extract/tracing.h"
+#include "core/extract/uv_atlas.h"
 #include "core/layout/layout.h"
 #include "core/mesh/geometry.h"
 
@@ -84,9 +85,13 @@ QuadMesh build_quad_mesh(const TriMesh& mesh, const GeometryCache& geometry, con
 QuadMesh build_quad_mesh(const Pipeline& pipeline, const Extraction& extraction,
                          const QuadMeshOptions& options);
 
-//! quads.obj: "v" per vertex, per-corner "vt" with the normalized patch coordinates
-//! (s/w, t/h) ∈ [0,1]², one "g patch_<id>" group per gridded patch, "f v/vt" quads. Atomic.
-void write_quads_obj(const QuadMesh& quads, const std::string& path);
+//! quads.obj: "v" per vertex, per-corner "vt" with the patch coordinates (s, t) ∈ [0,w]×[0,h]
+//! mapped to the patch's rectangle of uv_atlas over the gridded patches' sizes (kPerPatch:
+//! (s/w, t/h), every patch on [0,1]²; kPacked: non-overlapping rectangles), one
+//! "g patch_<id>" group per gridded patch, "f v/vt" quads. Atomic.
+//! \throw InvalidInputError for invalid \p atlas options.
+void write_quads_obj(const QuadMesh& quads, const std::string& path,
+                     const UvAtlasOptions& atlas = {});
 
 //! patches.json: per gridded patch its id, corner node ids, arc ids (sides 0..3), (w, h),
 //! (m, n), quad range and the 4 boundary curves as 3D polylines (side k from corner k to corner
@@ -94,13 +99,18 @@ void write_quads_obj(const QuadMesh& quads, const std::string& path);
 void write_patches_json(const QuadMesh& quads, const Layout& layout, const Extraction& extraction,
                         const std::string& path);
 
-//! layout_curves.obj: the traced arcs as OBJ polylines ("l"), one "g arc_<id>" group each, plus
-//! the nodes as "p" points (group "nodes"). Atomic.
+//! layout_curves.obj: one object "layout_curves"; first one "v" per node (in layout order, at
+//! the start of an arc from it or the end of a traced arc to it; nodes on no arc are left out),
+//! then the inner points of every arc's traced polyline. Per arc with at least 2 points a group
+//! "g arc_<id>" of 2-vertex line records "l a b", one per polyline segment from its `from` node
+//! to its `to` node, the end vertices being the node vertices (shared by all arcs at that node;
+//! a failed or dangling arc ends on a vertex of its own). Last, the node vertices as one
+//! "p" record in group "nodes". Atomic.
 void write_layout_curves_obj(const Layout& layout, const Extraction& extraction,
                              const std::string& path);
 
-//! Writes quads.obj, patches.json and layout_curves.obj into folder \p dir.
+//! Writes quads.obj (with \p atlas), patches.json and layout_curves.obj into folder \p dir.
 void write_quad_exports(const QuadMesh& quads, const Layout& layout, const Extraction& extraction,
-                        const std::string& dir);
+                        const std::string& dir, const UvAtlasOptions& atlas = {});
 
 }  // namespace qs

@@ -1,5 +1,6 @@
-# Quad mesh exports (issue #8) read by an independent reader: `assimp info` on quads.obj and
-# layout_curves.obj of the bundled example (raw import: quads stay polygons). Skipped (77) when assimp is not on PATH (Debian:
+# Quad mesh exports (issues #8, #44) read by an independent reader: `assimp info` on quads.obj and
+# layout_curves.obj of the bundled example (raw import: quads stay polygons; every line segment
+# of every arc read, one mesh per arc group). Skipped (77) when assimp is not on PATH (Debian:
 # assimp-utils, listed in scripts/install-deps.sh). Included by tests/CMakeLists.txt.
 
 # quads_test runs the command line too: build it first.
@@ -32,6 +33,16 @@ want=$(grep -c '^g patch_' "$4/quads.obj")
 got=$(sed -n 's/^ *Meshes: *\([0-9][0-9]*\).*/\1/p' "$4/quads.obj.assimp.txt" | head -n 1)
 [ "$got" = "$want" ] || { echo "assimp reads $got groups, quads.obj has $want"; exit 1; }
 grep -q 'line' "$4/layout_curves.obj.assimp.txt" || { echo "no polylines in layout_curves.obj"; exit 1; }
+# Every arc segment read (one 2-vertex l record per segment), one mesh per arc group.
+cat "$4/layout_curves.obj.assimp.txt"
+want=$(awk '$1 == "l" { n += NF - 2 } END { print n + 0 }' "$4/layout_curves.obj")
+got=$(sed -n 's/^ *[0-9][0-9]* (arc_[0-9]*): \[[0-9]* \/ [0-9]* \/ \([0-9]*\) | line\]$/\1/p' "$4/layout_curves.obj.assimp.txt" | awk '{ n += $1 } END { print n + 0 }')
+[ "$want" -gt 0 ] && [ "$got" = "$want" ] || { echo "assimp reads $got line segments, layout_curves.obj has $want"; exit 1; }
+want=$(grep -c '^g arc_' "$4/layout_curves.obj")
+got=$(grep -c '^ *[0-9][0-9]* (arc_[0-9]*): .* line\]$' "$4/layout_curves.obj.assimp.txt")
+[ "$got" = "$want" ] || { echo "assimp reads $got arcs, layout_curves.obj has $want"; exit 1; }
+bad=$(awk '$1 == "l" && NF != 3' "$4/layout_curves.obj" | wc -l)
+[ "$bad" -eq 0 ] || { echo "$bad l records with other than 2 vertices"; exit 1; }
 ]=] quads_assimp_info
     $<TARGET_FILE:quadsketch-cli>
     ${QS_ASSETS_DIR}/example/ellipsoid.obj
