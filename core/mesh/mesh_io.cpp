@@ -4,12 +4,11 @@
 // ply_reader.cpp, stl_reader.cpp and openmesh_reader.cpp), report formatting and the writer.
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <ostream>
-#include <system_error>
 
 #include "core/base/atomic_file.h"
 #include "core/base/errors.h"
+#include "core/base/input_file.h"
 #include "core/mesh/mesh_checks.h"
 #include "core/mesh/mesh_io.h"
 #include "core/mesh/mesh_readers.h"
@@ -22,17 +21,6 @@ using mesh_detail::lowercase;
 using mesh_detail::plural;
 
 constexpr std::size_t kMaxListedIds = 10;
-
-std::string read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw InvalidInputError(path + ": cannot open file");
-  std::string bytes(static_cast<std::size_t>(in.tellg()), '\0');
-  in.seekg(0);
-  if (!in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()))) {
-    throw InvalidInputError(path + ": cannot read file");
-  }
-  return bytes;
-}
 
 std::string extension_of(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
@@ -167,21 +155,16 @@ std::vector<std::string> MeshReport::problems() const {
 }
 
 PolygonSoup read_polygon_soup(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    throw InvalidInputError(path + ": cannot open file");
-  }
+  // Only regular files: a FIFO would block and a device such as /dev/zero never ends.
+  const std::string bytes = read_input_file(path);
   const std::string ext = extension_of(path);
   if (ext != "obj" && ext != "off" && ext != "ply" && ext != "stl") {
     throw InvalidInputError(path + ": unsupported file extension '" +
                             std::filesystem::path(path).extension().string() +
                             "' (expected .obj, .off, .ply or .stl)");
   }
-  const auto size = std::filesystem::file_size(path, ec);
-  if (ec) throw InvalidInputError(path + ": cannot open file");
-  if (size == 0) throw InvalidInputError(path + ": empty file");
+  if (bytes.empty()) throw InvalidInputError(path + ": empty file");
 
-  const std::string bytes = read_bytes(path);
   PolygonSoup soup;
   if (ext == "obj") {
     soup = mesh_detail::parse_obj(path, bytes);
