@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <ostream>
+#include <string_view>
 
 #include "core/base/atomic_file.h"
 #include "core/base/errors.h"
@@ -55,6 +56,13 @@ std::string face_list(const std::vector<int>& faces, const std::vector<int>& fac
   return s + ")";
 }
 
+// kMaxCoordinateMagnitude as written in messages ("1e+150").
+std::string magnitude_limit() {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", kMaxCoordinateMagnitude);
+  return text;
+}
+
 std::string vertex_list(const std::vector<int>& ids) {
   return std::string(ids.size() == 1 ? "(id " : "(ids ") + id_list(ids) + ")";
 }
@@ -91,7 +99,8 @@ bool MeshReport::ok() const {
   const bool components_ok = components == 1 || (multiple_components_allowed && components > 1);
   return input_faces > 0 && components_ok && dropped_faces.empty() &&
          nonmanifold_vertices.empty() && degenerate_faces.empty() && nonfinite_vertices.empty() &&
-         unreferenced_vertices.empty() && bad_index_faces.empty() && non_triangle_faces.empty() &&
+         out_of_range_vertices.empty() && unreferenced_vertices.empty() &&
+         bad_index_faces.empty() && non_triangle_faces.empty() && untriangulable_faces.empty() &&
          skipped_degenerate_faces == 0;
 }
 
@@ -109,6 +118,24 @@ std::vector<std::string> MeshReport::problems() const {
                   " non-finite coordinates " + vertex_list(nonfinite_vertices) +
                   ": NaN or infinite");
   }
+  if (!out_of_range_vertices.empty()) {
+    // "vertex 2 (line 3)": each named with its line, as the coordinates are the problem.
+    std::string which;
+    for (std::size_t i = 0; i < out_of_range_vertices.size() && i < kMaxListedIds; ++i) {
+      const int v = out_of_range_vertices[i];
+      const int line = v < static_cast<int>(vertex_lines.size()) ? vertex_lines[v] : 0;
+      which += (i ? ", vertex " : "vertex ") + std::to_string(v) +
+               (line > 0 ? " (line " + std::to_string(line) + ")" : "");
+    }
+    if (out_of_range_vertices.size() > kMaxListedIds) which += ", …";
+    const std::string why = " (above " + magnitude_limit() + ", where lengths and areas overflow)";
+    if (out_of_range_vertices.size() == 1) {
+      out.push_back(which + ": coordinate magnitude out of range" + why);
+    } else {
+      out.push_back(std::to_string(out_of_range_vertices.size()) +
+                    " vertices with coordinate magnitude out of range" + why + ": " + which);
+    }
+  }
   if (!degenerate_faces.empty()) {
     out.push_back(plural(degenerate_faces.size(), "degenerate face", "degenerate faces") + " " +
                   face_list(degenerate_faces, face_lines) + ": zero area or a repeated vertex");
@@ -121,6 +148,14 @@ std::vector<std::string> MeshReport::problems() const {
     out.push_back(plural(non_triangle_faces.size(), "face", "faces") +
                   " with more than 3 vertices " + face_list(non_triangle_faces, face_lines) +
                   ": triangulation is off");
+  }
+  if (!untriangulable_faces.empty()) {
+    const bool one = untriangulable_faces.size() == 1;
+    out.push_back(plural(untriangulable_faces.size(), "face", "faces") +
+                  " cannot be triangulated without inverted triangles " +
+                  face_list(untriangulable_faces, face_lines) +
+                  (one ? ": its outline crosses or touches itself in its plane"
+                       : ": their outlines cross or touch themselves in their planes"));
   }
   for (DropReason reason : {DropReason::kNonManifoldEdge, DropReason::kInconsistentOrientation,
                             DropReason::kNonManifoldVertex, DropReason::kDuplicate}) {
@@ -165,13 +200,19 @@ PolygonSoup read_polygon_soup(const std::string& path) {
   }
   if (bytes.empty()) throw InvalidInputError(path + ": empty file");
 
+  // Text formats may start with a UTF-8 byte-order mark; it is no part of the content.
+  const std::string_view text = mesh_detail::skip_utf8_bom(bytes);
   PolygonSoup soup;
   if (ext == "obj") {
-    soup = mesh_detail::parse_obj(path, bytes);
+    soup = mesh_detail::parse_obj(path, text);
   } else if (ext == "off") {
-    soup = mesh_detail::parse_off(path, bytes);
-  } else {
+    soup = mesh_detail::parse_off(path, text);
+  } else if (ext == "ply") {
+    soup = mesh_detail::read_with_openmesh(path, ext, text);
+  } else if (mesh_detail::is_binary_stl(bytes)) {  // its 80-byte header may hold anything
     soup = mesh_detail::read_with_openmesh(path, ext, bytes);
+  } else {
+    soup = mesh_detail::parse_ascii_stl(path, text);
   }
   if (soup.faces.empty() && soup.skipped_degenerate_faces == 0) {
     throw InvalidInputError(path + ": no faces (" +

@@ -17,6 +17,9 @@ constexpr std::size_t kMaxListedErrors = 10;
 std::string lowercase(std::string s);
 std::string uppercase(std::string s);
 
+//! \p text without a leading UTF-8 byte-order mark (EF BB BF), which some editors write.
+std::string_view skip_utf8_bom(std::string_view text);
+
 //! Space, tab, CR, VT or FF (not LF, which ends a line).
 bool is_space(char c);
 

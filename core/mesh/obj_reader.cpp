@@ -38,6 +38,7 @@ PolygonSoup parse_obj(const std::string& path, std::string_view text) {
       }
       // Kept even when broken, so that later relative indices still count correctly.
       soup.points.push_back(p);
+      soup.point_lines.push_back(lines.number());
     } else if (key == "f") {
       const std::size_t n = tokens.size() - 1;
       if (n < 3) {

@@ -75,6 +75,7 @@ PolygonSoup parse_off(const std::string& path, std::string_view text) {
   const int n_faces = static_cast<int>(counts[1]);
   // The counts come from the file: cap the reservation so a lying header cannot exhaust memory.
   soup.points.reserve(std::min(n_vertices, 1 << 24));
+  soup.point_lines.reserve(std::min(n_vertices, 1 << 24));
   soup.faces.reserve(std::min(n_faces, 1 << 24));
 
   const auto truncated = [&](const std::string& what) {
@@ -95,6 +96,7 @@ PolygonSoup parse_off(const std::string& path, std::string_view text) {
       parse_point(tokens, 0, p, errors, lines);
     }
     soup.points.push_back(p);
+    soup.point_lines.push_back(lines.number());
   }
   for (int f = 0; f < n_faces; ++f) {
     if (!next_tokens()) {

@@ -3,6 +3,7 @@
 #include <OpenMesh/Core/IO/IOManager.hh>
 #include <OpenMesh/Core/IO/importer/ImporterT.hh>
 #include <mutex>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -59,22 +60,33 @@ class SoupImporter : public OpenMesh::IO::ImporterT<PolyMesh> {
 }  // namespace
 
 PolygonSoup read_with_openmesh(const std::string& path, const std::string& format,
-                               std::string_view bytes) {
+                               std::string_view text) {
   long long expected_faces = -1;
   PlyInfo ply;
-  if (format == "stl") expected_faces = check_stl(path, bytes);
-  if (format == "ply") ply = check_ply(path, bytes);
-  if (format == "off") check_binary_off(path, bytes);
+  if (format == "stl" && !is_binary_stl(text, &expected_faces)) {
+    throw InvalidInputError(path + ": not a binary STL file");
+  }
+  if (format == "ply") ply = check_ply(path, text);
+  if (format == "off") check_binary_off(path, text);
 
   PolyMesh scratch;
   PolygonSoup soup;
   SoupImporter importer(scratch, soup);
   OpenMesh::IO::Options options;  // request nothing but positions and faces
+  // A stream has no name to tell the STL variant from.
+  if (format == "stl") options += OpenMesh::IO::Options::Binary;
   // OpenMesh's readers are singletons with mutable state (options of the current file), so
   // two threads must not read at the same time.
   static std::mutex openmesh_readers;
   const std::lock_guard<std::mutex> lock(openmesh_readers);
-  if (!OpenMesh::IO::IOManager().read(path, importer, options)) {
+  bool read = false;
+  if (format == "off") {
+    read = OpenMesh::IO::IOManager().read(path, importer, options);
+  } else {
+    std::istringstream in(std::string(text), std::ios::in | std::ios::binary);
+    read = OpenMesh::IO::IOManager().read(in, format, importer, options);
+  }
+  if (!read) {
     throw InvalidInputError(path + ": OpenMesh's " + uppercase(format) +
                             " reader could not read the file (malformed or unsupported " +
                             uppercase(format) + ")");

@@ -209,9 +209,9 @@ void check_ply_records(const std::string& path, std::string_view bytes, const Pl
 
 }  // namespace
 
-PlyInfo check_ply(const std::string& path, std::string_view bytes) {
-  const PlyHeader header = parse_ply_header(path, bytes);
-  check_ply_records(path, bytes, header);
+PlyInfo check_ply(const std::string& path, std::string_view text) {
+  const PlyHeader header = parse_ply_header(path, text);
+  check_ply_records(path, text, header);
   return {header.vertices, header.faces, header.double_coordinates};
 }
 
