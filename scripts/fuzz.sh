@@ -2,7 +2,8 @@
 # Builds the libFuzzer targets of fuzz/ (clang, ASan+UBSan) and runs each for N seconds
 # (default 60). Any crash, leak, timeout (>10 s per input) or sanitizer report fails the run;
 # the reproducer is saved as build-fuzz/artifacts/<target>-crash-* (replay it with
-# build-fuzz/fuzz/<target> FILE). Seeds: fuzz/corpus/, assets/example/ and assets/bad/.
+# build-fuzz/fuzz/<target> FILE). Seeds: fuzz/corpus/ (valid inputs, e.g. with a byte-order
+# mark), assets/example/ and assets/bad/.
 # Usage: scripts/fuzz.sh [seconds] [target...]    (targets: layout_fuzzer mesh_fuzzer
 # quads_fuzzer). QS_FUZZ_BUILD_DIR moves the build folder (default: build-fuzz).
 set -euo pipefail
@@ -25,9 +26,11 @@ cmake --build "$build" -j"$(nproc)" --target "${targets[@]}"
 seeds() {  # target -> seed files
   local f
   case "$1" in
-    layout_fuzzer) printf '%s\n' assets/example/*.layout.json assets/bad/*.layout.json ;;
+    layout_fuzzer)
+      printf '%s\n' assets/example/*.layout.json assets/bad/*.layout.json fuzz/corpus/layout/*
+      ;;
     mesh_fuzzer)
-      for f in assets/bad/* fuzz/corpus/quads/*; do
+      for f in assets/bad/* fuzz/corpus/mesh/* fuzz/corpus/quads/*; do
         case "$f" in *.json | *README*) ;; *) echo "$f" ;; esac
       done
       ;;

@@ -1,5 +1,6 @@
 // quadsketch-cli end to end: exit codes, the bad-input corpus, and the output files.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <filesystem>
 #include <fstream>
@@ -56,6 +57,8 @@ const std::map<std::string, std::vector<std::string>> kLayoutExpectations = {
     {"crossing_arcs.layout.json", {"arc_crossing", "arcs 0 and 100"}},
     {"five_sided_patch.layout.json", {"patch_valence", "5 corners", "a full patch needs 4"}},
     {"missing_node.layout.json", {"unknown_node", "arc 3", "unknown node 42"}},
+    {"node_vertex_and_point.layout.json",
+     {"node 0: has both \"vertex\": 39 and a \"point\" that snaps to vertex"}},
     {"malformed.layout.json", {"malformed JSON", "line"}},
 };
 
@@ -83,6 +86,25 @@ TEST(Cli, MissingFileIsInvalidInput) {
             2)
       << out;
   EXPECT_NE(out.find("/nonexistent/x.obj"), std::string::npos) << out;
+}
+
+TEST(Cli, LayoutThatIsNotARegularFileIsRefusedWithoutReadingOrBlocking) {
+  const std::string dir = test::temp_dir("cli_fifo");
+  const std::string fifo = dir + "/layout.json";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  // `timeout` turns a run that blocks on the FIFO (or reads /dev/zero for ever) into exit 124.
+  for (const auto& [path, kind] : {std::pair<std::string, std::string>{fifo, "a FIFO (named pipe)"},
+                                   {"/dev/zero", "a character device"},
+                                   {dir, "a directory"}}) {
+    std::string out;
+    EXPECT_EQ(test::run_command(
+                  "timeout 60 " + cli("validate --mesh " + kMesh + " --layout " + path), &out),
+              2)
+        << out;
+    EXPECT_NE(out.find(path + ": cannot open file: it is " + kind + ", not a regular file"),
+              std::string::npos)
+        << out;
+  }
 }
 
 TEST(Cli, EveryBrokenInputGivesItsErrorAndExitCode2) {

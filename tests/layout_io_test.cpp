@@ -343,6 +343,14 @@ TEST(LayoutIo, NodeWithVertexAndPointKeepsVertex) {
   EXPECT_EQ(x.nodes[0].point->face, 1);
 }
 
+TEST(LayoutIo, LeadingByteOrderMarkIsSkipped) {
+  const Layout x = parse_layout_json("\xEF\xBB\xBF" + doc(), "bom.json");
+  ASSERT_EQ(x.nodes.size(), 1u);
+  EXPECT_EQ(x.nodes[0].vertex, 1);
+  // Error columns on the first line count from the first visible character.
+  expect_parse_error("\xEF\xBB\xBF{x}", {"malformed JSON at line 1, column 2: "});
+}
+
 TEST(LayoutIo, IgnoresUnknownFieldsAndAcceptsIntegralNumbers) {
   const Layout x = parse_layout_json(
       doc(R"({"id": 0, "vertex": 17.0, "color": "red"})",
@@ -570,6 +578,41 @@ TEST_F(LayoutFileTest, UnreadableAndMalformedFilesNameThePath) {
   }
   const std::string bad = write("bad.json", "{\n\"format\": }");
   expect_load_error(bad, mesh, {"malformed JSON at line 2, column 11"});
+}
+
+TEST_F(LayoutFileTest, OnlyRegularFilesOfBoundedSizeAreRead) {
+  const TriMesh mesh = grid_mesh(3);
+  const std::string folder = (dir_ / "folder.json").string();
+  fs::create_directories(folder);
+  expect_load_error(folder, mesh, {"cannot open file: it is a directory, not a regular file"});
+  expect_load_error("/dev/zero", mesh, {"it is a character device, not a regular file"});
+  // A sparse file just over the limit is refused from its size, before anything is read.
+  const std::string huge = write("huge.json", "{}");
+  fs::resize_file(huge, kMaxLayoutFileBytes + 1);
+  expect_load_error(huge, mesh,
+                    {"file too large: " + std::to_string(kMaxLayoutFileBytes + 1) +
+                     " bytes (the limit is " + std::to_string(kMaxLayoutFileBytes) + " bytes)"});
+}
+
+TEST_F(LayoutFileTest, NodeWithAVertexAndAPointElsewhereIsRefused) {
+  const TriMesh mesh = grid_mesh(10);
+  std::vector<int> corners;
+  for (const auto vh : mesh.fv_range(OpenMesh::FaceHandle(20))) corners.push_back(vh.idx());
+  // Node 4's point is at corner 0 of face 20, its vertex is 88: one of them would be ignored.
+  const std::string path =
+      write("both.json", doc(R"({"id": 4, "vertex": 88, "point": {"face": 20, "bary": [1, 0, 0]}})",
+                             R"({"id": 0, "from": 4, "to": null, "path": [88, 89]})"));
+  expect_load_error(path, mesh,
+                    {"node 4: has both \"vertex\": 88 and a \"point\" that snaps to vertex " +
+                     std::to_string(corners[0])});
+  // A point that snaps to the node's vertex (as written for snapped and output nodes) is fine.
+  const std::string agree = write(
+      "agree.json",
+      doc(R"({"id": 4, "vertex": )" + std::to_string(corners[1]) +
+              R"(, "point": {"face": 20, "bary": [0.1, 0.8, 0.1]}})",
+          R"({"id": 0, "from": 4, "to": null, "path": [)" + std::to_string(corners[1]) + "]}"));
+  const Layout x = load_layout(agree, mesh);
+  EXPECT_EQ(x.nodes[0].vertex, corners[1]);
 }
 
 TEST_F(LayoutFileTest, NodeProblemsAreAllListedWithIds) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <filesystem>
 
 #include "core/base/atomic_file.h"
@@ -96,6 +97,41 @@ TEST(Perturb, SameSeedSameResult) {
   options.seed = 43;
   const std::string c = layout_to_json(perturb_layout(r.mesh, r.layout, options).layout);
   EXPECT_NE(a, c);
+}
+
+TEST(Perturb, MovedNodesDropTheOutputFieldsOfTheirOldVertex) {
+  const QuadImportResult r = refined_cube(2, 4);
+  // Like an optimize output: every node carries a point at its vertex, a position, a valence.
+  Layout input = r.layout;
+  for (LayoutNode& node : input.nodes) {
+    const auto vh = r.mesh.vertex_handle(node.vertex);
+    const auto fh = *r.mesh.cvf_begin(vh);
+    SurfacePoint at_vertex{fh.idx(), {0.0, 0.0, 0.0}};
+    int k = 0;
+    for (const auto corner : r.mesh.fv_range(fh)) at_vertex.bary[k++] = corner == vh ? 1.0 : 0.0;
+    node.point = at_vertex;
+    const Vec3& x = r.mesh.point(vh);
+    node.position = std::array<double, 3>{x[0], x[1], x[2]};
+    node.valence = 3;
+  }
+  PerturbLayoutOptions options;
+  options.rings = 2;
+  options.seed = 7;
+  const PerturbResult p = perturb_layout(r.mesh, input, options);
+  ASSERT_FALSE(p.moved_nodes.empty());
+  for (int id : p.moved_nodes) {
+    const LayoutNode& node = p.layout.nodes[p.layout.node_index(id)];
+    EXPECT_FALSE(node.point.has_value()) << "node " << id;
+    EXPECT_FALSE(node.position.has_value()) << "node " << id;
+    EXPECT_EQ(node.valence, -1) << "node " << id;
+  }
+  for (int id : p.stuck_nodes) {
+    EXPECT_TRUE(p.layout.nodes[p.layout.node_index(id)].point.has_value()) << "node " << id;
+  }
+  // The written result is a valid input: no node's point contradicts its vertex.
+  const std::string path = test::temp_dir("perturb_outputs") + "/perturbed.json";
+  save_layout(p.layout, path, &r.mesh);
+  EXPECT_NO_THROW(load_layout(path, r.mesh));
 }
 
 TEST(Perturb, PinnedNodesStay) {

@@ -5,10 +5,12 @@
 #include <cstdint>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <string_view>
 #include <utility>
 
 #include "core/base/atomic_file.h"
 #include "core/base/errors.h"
+#include "core/base/input_file.h"
 #include "core/layout/routing.h"
 
 namespace qs {
@@ -27,7 +29,7 @@ constexpr int kVersion = 1;
 
 //! 1-based line and column (in characters, counting a UTF-8 sequence once) of byte offset
 //! \p offset (0-based) of \p text. Offsets past the end refer to the position after the text.
-std::pair<int, int> line_column(const std::string& text, size_t offset) {
+std::pair<int, int> line_column(std::string_view text, size_t offset) {
   offset = std::min(offset, text.size());
   int line = 1;
   int column = 1;
@@ -493,12 +495,17 @@ std::string surface_point_problem(const TriMesh& mesh, const SurfacePoint& p) {
 }  // namespace
 
 Layout parse_layout_json(const std::string& text, const std::string& source_name) {
+  // A leading UTF-8 byte-order mark (written by some editors) is skipped, so that error
+  // columns on the first line count from the first visible character.
+  constexpr std::string_view kBom = "\xEF\xBB\xBF";
+  std::string_view body = text;
+  if (body.substr(0, kBom.size()) == kBom) body.remove_prefix(kBom.size());
   Json doc;
   try {
-    doc = Json::parse(text);
+    doc = Json::parse(body.begin(), body.end());
   } catch (const Json::parse_error& e) {
     // e.byte is the 1-based index of the offending byte (one past the end at end of input).
-    const auto [line, column] = line_column(text, e.byte > 0 ? e.byte - 1 : 0);
+    const auto [line, column] = line_column(body, e.byte > 0 ? e.byte - 1 : 0);
     throw InvalidInputError(source_name + ": malformed JSON at line " + std::to_string(line) +
                             ", column " + std::to_string(column) + ": " +
                             json_error_detail(e.what()));
@@ -509,9 +516,9 @@ Layout parse_layout_json(const std::string& text, const std::string& source_name
     const size_t q1 = what.find('\'');
     const size_t q2 = q1 == std::string::npos ? q1 : what.find('\'', q1 + 1);
     if (q2 != std::string::npos && q2 > q1 + 1) {
-      const size_t at = text.find(what.substr(q1 + 1, q2 - q1 - 1));
+      const size_t at = body.find(what.substr(q1 + 1, q2 - q1 - 1));
       if (at != std::string::npos) {
-        const auto [line, column] = line_column(text, at);
+        const auto [line, column] = line_column(body, at);
         where = " at line " + std::to_string(line) + ", column " + std::to_string(column);
       }
     }
@@ -522,7 +529,7 @@ Layout parse_layout_json(const std::string& text, const std::string& source_name
 }
 
 Layout load_layout(const std::string& path, const TriMesh& mesh) {
-  Layout layout = parse_layout_json(read_file(path), path);
+  Layout layout = parse_layout_json(read_input_file(path, kMaxLayoutFileBytes), path);
   const int nv = static_cast<int>(mesh.n_vertices());
   const int nf = static_cast<int>(mesh.n_faces());
   if (layout.mesh_vertices >= 0 && (layout.mesh_vertices != nv || layout.mesh_faces != nf)) {
@@ -544,7 +551,16 @@ Layout load_layout(const std::string& path, const TriMesh& mesh) {
       if (!problem.empty()) {
         problems.push_back(who + ": point: " + problem);
       } else if (node.vertex < 0) {
-        node.vertex = snap_to_vertex(mesh, *node.point);  // `vertex` wins when both are given
+        node.vertex = snap_to_vertex(mesh, *node.point);
+      } else if (node.vertex < nv) {
+        // Both given (as written for snapped and output nodes): they must name the same vertex,
+        // else one of them would be ignored silently.
+        const int snapped = snap_to_vertex(mesh, *node.point);
+        if (snapped != node.vertex) {
+          problems.push_back(who + ": has both \"vertex\": " + std::to_string(node.vertex) +
+                             " and a \"point\" that snaps to vertex " + std::to_string(snapped) +
+                             " (give only one, or a point at that vertex)");
+        }
       }
     }
   }

@@ -38,6 +38,7 @@ class Perturber {
     reference_order_ = topo.node_half_arcs;
     node_arcs_.assign(layout.nodes.size(), {});
     for (size_t n = 0; n < layout.nodes.size(); ++n) {
+      input_vertex_.push_back(layout.nodes[n].vertex);
       vertex_node_[layout.nodes[n].vertex] = static_cast<int>(n);
       obstacles_.vertex_blocked[layout.nodes[n].vertex] = 1;
     }
@@ -71,6 +72,7 @@ class Perturber {
         result_.moved_nodes.push_back(id);
       }
     }
+    clear_moved_node_outputs();
     return std::move(result_);
   }
 
@@ -100,11 +102,24 @@ class Perturber {
       if (crowded(n, layout.nodes[n].vertex, options.min_distance))
         out.still_crowded.push_back(layout.nodes[n].id);
     }
+    clear_moved_node_outputs();
     out.layout = std::move(layout);
     return out;
   }
 
  private:
+  // A moved node's output fields (point, position, valence) describe its old vertex; a stale
+  // `point` would contradict `vertex` (load_layout refuses such a node).
+  void clear_moved_node_outputs() {
+    for (size_t n = 0; n < input_vertex_.size(); ++n) {
+      LayoutNode& node = result_.layout.nodes[n];
+      if (node.vertex == input_vertex_[n]) continue;
+      node.point.reset();
+      node.position.reset();
+      node.valence = -1;
+    }
+  }
+
   // Not pinned, no pinned arc, no loop arc, at least one arc: the nodes perturb may move.
   bool may_move(int n) const {
     const Layout& layout = result_.layout;
@@ -464,6 +479,7 @@ class Perturber {
   std::mt19937 rng_;
   PathFinder finder_;
   PerturbResult result_;
+  std::vector<int> input_vertex_;  // per node, its vertex in the input layout
   std::vector<int> vertex_node_, vertex_arc_, edge_arc_;
   RoutingObstacles obstacles_;
   std::vector<char> region_;

@@ -17,7 +17,9 @@ struct PerturbLayoutOptions {
 };
 
 struct PerturbResult {
-  Layout layout;                  //!< the perturbed layout (same ids, same order)
+  //! The perturbed layout (same ids, same order). Moved nodes lose their output fields
+  //! (point, position, valence), which described their old vertex.
+  Layout layout;
   std::vector<int> moved_nodes;   //!< ids of the nodes that moved
   std::vector<int> stuck_nodes;   //!< ids of unpinned nodes left in place (no valid move)
   std::vector<int> pinned_nodes;  //!< ids of nodes kept because they or one of their arcs
@@ -49,7 +51,9 @@ struct SeparateNodesOptions {
 };
 
 struct SeparateNodesResult {
-  Layout layout;                   //!< the layout with crowded nodes moved (same ids, order)
+  //! The layout with crowded nodes moved (same ids, order; moved nodes lose their output
+  //! fields like in PerturbResult).
+  Layout layout;
   std::vector<int> crowded_nodes;  //!< ids of the nodes crowded in the input
   std::vector<int> moved_nodes;    //!< ids of the nodes moved
   std::vector<int> still_crowded;  //!< ids of the nodes crowded in the result

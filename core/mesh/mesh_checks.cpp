@@ -7,7 +7,10 @@
 #include <deque>
 #include <limits>
 #include <numeric>
+#include <span>
 #include <utility>
+
+#include "core/mesh/triangulate.h"
 
 namespace qs {
 namespace {
@@ -22,14 +25,20 @@ bool is_finite(const Vec3& p) {
   return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
 }
 
-// Diagonal of the bounding box of the finite points (0 when there are none).
+// Finite, and small enough for squared lengths and areas to stay finite.
+bool in_range(const Vec3& p) {
+  return is_finite(p) && std::abs(p[0]) <= kMaxCoordinateMagnitude &&
+         std::abs(p[1]) <= kMaxCoordinateMagnitude && std::abs(p[2]) <= kMaxCoordinateMagnitude;
+}
+
+// Diagonal of the bounding box of the in-range points (0 when there are none).
 double bbox_diagonal(const std::vector<Vec3>& points) {
   constexpr double kBig = std::numeric_limits<double>::max();
   Vec3 lo(kBig, kBig, kBig);
   Vec3 hi(-kBig, -kBig, -kBig);
   bool any = false;
   for (const Vec3& p : points) {
-    if (!is_finite(p)) continue;
+    if (!in_range(p)) continue;
     lo.minimize(p);
     hi.maximize(p);
     any = true;
@@ -37,53 +46,10 @@ double bbox_diagonal(const std::vector<Vec3>& points) {
   return any ? (hi - lo).norm() : 0.0;
 }
 
-// Area of a planar or slightly non-planar polygon from its vector area (Newell), so that
-// the same rule covers triangles and the polygons of quad meshes.
-double polygon_area(const int* face, std::size_t n, const std::vector<Vec3>& points) {
-  Vec3 twice_area(0.0, 0.0, 0.0);
-  const Vec3& origin = points[face[0]];
-  for (std::size_t i = 1; i + 1 < n; ++i) {
-    twice_area += OpenMesh::cross(points[face[i]] - origin, points[face[i + 1]] - origin);
-  }
-  return 0.5 * twice_area.norm();
-}
-
-// Smallest corner angle of a triangle in radians (NaN if a coordinate is not finite).
-double min_angle_rad(const Vec3& a, const Vec3& b, const Vec3& c) {
-  const auto angle = [](const Vec3& apex, const Vec3& p, const Vec3& q) {
-    const Vec3 u = p - apex;
-    const Vec3 v = q - apex;
-    // atan2 stays accurate for angles near 0 and pi, unlike acos of a normalized dot product.
-    return std::atan2(OpenMesh::cross(u, v).norm(), OpenMesh::dot(u, v));
-  };
-  return std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
-}
-
-// Splits a polygon into a fan from the corner whose worst triangle has the largest smallest
-// angle. Ties keep the first corner, so the result only depends on the file.
-std::vector<std::vector<int>> fan_triangulate(const std::vector<int>& face,
-                                              const std::vector<Vec3>& points) {
-  const std::size_t n = face.size();
-  std::size_t best_corner = 0;
-  double best_angle = -1.0;
-  for (std::size_t c = 0; c < n; ++c) {
-    double worst = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 1; i + 1 < n; ++i) {
-      worst = std::min(worst, min_angle_rad(points[face[c]], points[face[(c + i) % n]],
-                                            points[face[(c + i + 1) % n]]));
-    }
-    if (worst > best_angle) {  // false for NaN: non-finite polygons keep corner 0
-      best_angle = worst;
-      best_corner = c;
-    }
-  }
-  std::vector<std::vector<int>> triangles;
-  triangles.reserve(n - 2);
-  for (std::size_t i = 1; i + 1 < n; ++i) {
-    triangles.push_back(
-        {face[best_corner], face[(best_corner + i) % n], face[(best_corner + i + 1) % n]});
-  }
-  return triangles;
+// Area of a polygon from its vector area (Newell), so that the same rule covers triangles and
+// the polygons of quad meshes.
+double polygon_area(std::span<const int> face, const std::vector<Vec3>& points) {
+  return polygon_vector_area(face, points).norm();
 }
 
 class UnionFind {
@@ -240,13 +206,24 @@ MeshT build_mesh(const PolygonSoup& soup, MeshReport& report, bool split_polygon
   report.skipped_degenerate_faces = soup.skipped_degenerate_faces;
   report.face_lines = soup.face_lines;
   report.face_lines.resize(n_faces, 0);
+  report.vertex_lines = soup.point_lines;
+  report.vertex_lines.resize(n_vertices, 0);
   report.warnings.insert(report.warnings.end(), soup.warnings.begin(), soup.warnings.end());
 
   // All vertices first and in file order, so that TriMesh indices are the file's indices.
   mesh.reserve(n_vertices, 3 * n_faces, 2 * n_faces);
+  // Geometry is only judged on faces whose corners are all in range (usable[v]); the others
+  // are reported through their vertices.
+  std::vector<char> usable(n_vertices, 1);
   for (int v = 0; v < n_vertices; ++v) {
     mesh.add_vertex(soup.points[v]);
-    if (!is_finite(soup.points[v])) report.nonfinite_vertices.push_back(v);
+    if (!is_finite(soup.points[v])) {
+      report.nonfinite_vertices.push_back(v);
+      usable[v] = 0;
+    } else if (!in_range(soup.points[v])) {
+      report.out_of_range_vertices.push_back(v);
+      usable[v] = 0;
+    }
   }
   const double diagonal = bbox_diagonal(soup.points);
   const double min_area = kZeroAreaFactor * diagonal * diagonal;
@@ -256,7 +233,7 @@ MeshT build_mesh(const PolygonSoup& soup, MeshReport& report, bool split_polygon
   added.vertices.reserve(3 * n_faces);
   added.offsets.reserve(n_faces + 1);
   std::vector<OpenMesh::VertexHandle> vhs;
-  std::vector<std::vector<int>> triangles;
+  std::vector<std::array<int, 3>> triangles;
   const auto drop = [&](int f, DropReason reason) {
     if (!report.dropped_faces.empty() && report.dropped_faces.back() == f) return;
     report.dropped_faces.push_back(f);
@@ -292,25 +269,32 @@ MeshT build_mesh(const PolygonSoup& soup, MeshReport& report, bool split_polygon
       continue;
     }
     // Zero-area faces are still added: the topology checks stay meaningful around them.
-    // A NaN area fails the test on purpose; such faces are reported as non-finite.
+    const bool judged = std::all_of(face.begin(), face.end(), [&](int v) { return usable[v]; });
+    const bool zero_area = judged && polygon_area(face, soup.points) <= min_area;
     if (split_polygons && face.size() > 3) {
       if (!options.triangulate) {
         report.non_triangle_faces.push_back(f);
         continue;
       }
-      triangles = fan_triangulate(face, soup.points);
       ++report.triangulated_faces;
-      for (const auto& t : triangles) {
-        if (polygon_area(t.data(), 3, soup.points) <= min_area) {
-          report.degenerate_faces.push_back(f);
-          break;
+      triangles.clear();
+      if (judged && !zero_area) {
+        triangles = triangulate_polygon(face, soup.points);
+        if (triangles.empty()) report.untriangulable_faces.push_back(f);
+      }
+      if (triangles.empty()) {  // a fan from the first corner, for the topology checks only
+        for (std::size_t i = 1; i + 1 < face.size(); ++i) {
+          triangles.push_back({face[0], face[i], face[i + 1]});
         }
       }
+      bool degenerate = zero_area;
+      for (const auto& t : triangles) {
+        degenerate = degenerate || (judged && polygon_area(t, soup.points) <= min_area);
+      }
+      if (degenerate) report.degenerate_faces.push_back(f);
       for (const auto& t : triangles) add(f, t.data(), 3);
     } else {
-      if (polygon_area(face.data(), face.size(), soup.points) <= min_area) {
-        report.degenerate_faces.push_back(f);
-      }
+      if (zero_area) report.degenerate_faces.push_back(f);
       add(f, face.data(), face.size());
     }
   }

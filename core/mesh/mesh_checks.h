@@ -11,16 +11,22 @@ namespace qs {
 
 //! Builds a triangle mesh from a soup, recording every problem in \p report (it never throws).
 //! All soup vertices are added first in order (vertex idx() == soup index, unreferenced ones
-//! included); faces follow in soup order, polygons expanding in place into a fan from the
-//! corner whose worst triangle has the largest smallest angle (or, with
-//! options.triangulate == false, being reported in non_triangle_faces).
+//! included); faces follow in soup order, polygons expanding in place into the triangles of
+//! triangulate_polygon (or, with options.triangulate == false, being reported in
+//! non_triangle_faces).
 //! Checks, all from the soup or the built mesh, never silently repaired:
 //! - bad_index_faces: an index outside [0, #points).
-//! - degenerate_faces: a repeated vertex index (not added), or zero area, i.e.
-//!   area <= 1e-14 * (bounding-box diagonal of the finite points)^2 (still added). Real
-//!   slivers stay valid (smallest area / diagonal^2 among the shared meshes: bunny.off 7e-9,
-//!   block.off 1e-7); collinear corners give 0 or rounding noise up to ~1e-15.
 //! - nonfinite_vertices: NaN or infinite coordinates.
+//! - out_of_range_vertices: a finite coordinate of magnitude above kMaxCoordinateMagnitude.
+//!   Faces with a non-finite or out-of-range corner are not judged geometrically (not
+//!   degenerate, not untriangulable; polygons are split into a fan from their first corner).
+//! - degenerate_faces: a repeated vertex index (not added), or zero area, i.e.
+//!   area <= 1e-14 * (bounding-box diagonal of the in-range points)^2 (still added), for the
+//!   polygon or one of its triangles. Real slivers stay valid (smallest area / diagonal^2
+//!   among the shared meshes: bunny.off 7e-9, block.off 1e-7); collinear corners give 0 or
+//!   rounding noise up to ~1e-15.
+//! - untriangulable_faces: a polygon with non-zero area that triangulate_polygon cannot split
+//!   (still added, as a fan from its first corner).
 //! - dropped_faces / drop_reasons: add_face refused the face (an edge that already has two
 //!   faces, an edge already used in the same direction, a complex vertex) or it repeats an
 //!   earlier face's vertex cycle in either direction.

@@ -8,14 +8,19 @@
 
 namespace qs {
 
+//! Largest accepted coordinate magnitude. Beyond it, squared lengths and areas of the mesh's
+//! own extent overflow a double (e.g. (2 * 1e155)^2 = 4e310), so no geometry can be trusted.
+constexpr double kMaxCoordinateMagnitude = 1e150;
+
 //! Raw content of a mesh file before any connectivity is built.
 struct PolygonSoup {
   std::vector<Vec3> points;             //!< one per file vertex, in file order
   std::vector<std::vector<int>> faces;  //!< 0-based vertex indices, one entry per file face
   std::vector<int> face_lines;          //!< 1-based source line of each face (0 if unknown)
+  std::vector<int> point_lines;         //!< 1-based source line of each vertex (0 if unknown)
   std::vector<std::string> warnings;    //!< non-fatal remarks of the reader (ignored statements)
-  //! Faces the format's reader skipped without telling which (OpenMesh's STL reader drops
-  //! triangles with coinciding corners); each one is a degenerate face.
+  //! Faces the format's reader skipped without telling which (OpenMesh's binary STL reader
+  //! drops triangles with coinciding corners); each one is a degenerate face.
   int skipped_degenerate_faces = 0;
 };
 
@@ -46,12 +51,18 @@ struct MeshReport {
   std::vector<int> nonmanifold_vertices;  //!< vertex indices whose faces do not form one fan
   std::vector<int> degenerate_faces;      //!< file face indices with zero area or repeated vertices
   std::vector<int> nonfinite_vertices;    //!< vertex indices with NaN or infinite coordinates
-  std::vector<int> unreferenced_vertices;    //!< vertex indices used by no face
-  std::vector<int> bad_index_faces;          //!< file face indices referring to missing vertices
-  std::vector<int> non_triangle_faces;       //!< file faces with > 3 vertices (triangulate off)
+  //! Vertex indices with a finite coordinate of magnitude above kMaxCoordinateMagnitude.
+  std::vector<int> out_of_range_vertices;
+  std::vector<int> unreferenced_vertices;  //!< vertex indices used by no face
+  std::vector<int> bad_index_faces;        //!< file face indices referring to missing vertices
+  std::vector<int> non_triangle_faces;     //!< file faces with > 3 vertices (triangulate off)
+  //! File faces with > 3 vertices that have no triangulation keeping their orientation (their
+  //! outline crosses or touches itself in their plane; see triangulate_polygon).
+  std::vector<int> untriangulable_faces;
   int skipped_degenerate_faces = 0;          //!< see PolygonSoup::skipped_degenerate_faces
   bool multiple_components_allowed = false;  //!< copied from LoadMeshOptions
   std::vector<int> face_lines;               //!< source line per file face (0 if unknown)
+  std::vector<int> vertex_lines;             //!< source line per file vertex (0 if unknown)
   std::vector<std::string> warnings;         //!< non-fatal remarks (e.g. triangulated faces)
 
   //! True when there is no fatal problem (one component is also required unless
@@ -62,23 +73,27 @@ struct MeshReport {
 };
 
 struct LoadMeshOptions {
-  //! Split faces with more than 3 vertices (fan from the best-shaped corner) with a warning.
-  //! When false such faces are an error.
+  //! Split faces with more than 3 vertices (triangulate_polygon) with a warning. When false
+  //! such faces are an error.
   bool triangulate = true;
   //! Accept several connected components (the pipeline needs exactly one).
   bool allow_multiple_components = false;
 };
 
 //! Reads the raw vertices and faces of a mesh file (format from the extension: .obj, .off,
-//! .ply, .stl; case-insensitive). OBJ and ASCII OFF are parsed here with line-precise errors
-//! ("file.obj:12: vertex has 2 coordinates, expected 3") and exact double coordinates.
+//! .ply, .stl; case-insensitive). Only a regular file is read (read_input_file). OBJ, ASCII
+//! OFF and ASCII STL are parsed here with line-precise errors ("file.obj:12: vertex has 2
+//! coordinates, expected 3") and exact double coordinates. A leading UTF-8 byte-order mark
+//! is skipped in every text format (OBJ, OFF, ASCII STL, the PLY header).
 //! OBJ: v (x y z, optional w or RGB) and f (v, v/vt, v/vt/vn, v//vn, negative = relative);
 //! vt/vn/vp/o/g/s/usemtl/mtllib/l are ignored, other statements too, with a warning.
 //! OFF: [ST][C][N]OFF header, counts on the header line or the next; a face may continue on
 //! the next lines when they hold only its missing indices; an optional colour may follow.
-//! PLY, STL and binary OFF go through OpenMesh's readers with an importer that records the
-//! raw indices. Precision: STL and binary OFF are float formats; OpenMesh 9 reads PLY
-//! coordinates as float too (a warning is added when the file declares double x/y/z).
+//! ASCII STL: "solid" ... "endsolid" blocks of facets (three "vertex x y z" each); corners
+//! with equal coordinates are one vertex; a file without its final "endsolid" is refused.
+//! PLY, binary STL and binary OFF go through OpenMesh's readers with an importer that records
+//! the raw indices. Precision: binary STL and binary OFF are float formats; OpenMesh 9 reads
+//! PLY coordinates as float too (a warning is added when the file declares double x/y/z).
 //! Out-of-range face indices are kept (build_*_mesh reports them).
 //! \throw InvalidInputError naming the file (and line) if the file is missing ("<path>:
 //!        cannot open file"), empty ("<path>: empty file"), has an unsupported extension,
