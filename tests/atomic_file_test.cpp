@@ -5,16 +5,22 @@
 #include "core/base/atomic_file.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iostream>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "core/base/errors.h"
 #include "tests/fixtures.h"
 
 namespace qs {
@@ -82,6 +88,72 @@ TEST(AtomicFileDeathTest, StopForExitRemovesTheWriteInProgressAndBlocksNewOnes) 
   EXPECT_EXIT(child(), testing::ExitedWithCode(0), "");
   EXPECT_EQ(read_file(path), "old\n");
   EXPECT_TRUE(hidden_files(dir).empty());
+}
+
+// A write the system refuses (in a child process, at a file-size limit: EFBIG, as a full disk
+// gives ENOSPC) names the target, not the temporary file, with the system's reason; the target
+// keeps its old content and no temporary file is left.
+TEST(AtomicFileDeathTest, AWriteErrorNamesTheTargetAndTheSystemsReason) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");  // the math libraries' threads
+  const std::string dir = test::temp_dir("atomic_file_write_error");
+  const std::string path = dir + "/out.txt";
+  write_file_atomic(path, std::string("old\n"));
+  auto child = [&] {
+    std::signal(SIGXFSZ, SIG_IGN);  // the write fails with EFBIG instead
+    const rlimit limit{4096, 4096};
+    setrlimit(RLIMIT_FSIZE, &limit);
+    try {
+      write_file_atomic(path, std::string(1 << 20, 'x'));
+    } catch (const QsError& e) {
+      std::cerr << e.what() << std::endl;
+      std::_Exit(read_file(path) == "old\n" && hidden_files(dir).empty() ? 0 : 2);
+    }
+    std::_Exit(1);
+  };
+  // (The threadsafe child runs the test again, in a folder of its own process id.)
+  EXPECT_EXIT(child(), testing::ExitedWithCode(0),
+              "^cannot write '/[^']*/qs_test_atomic_file_write_error_[0-9]+/out.txt': File too "
+              "large\n$");
+}
+
+TEST(AtomicFile, WritableFoldersAreCreatedAndCheckedUpFront) {
+  const std::string dir = test::temp_dir("atomic_file_writable");
+  require_writable_folder(dir + "/new/sub");
+  EXPECT_TRUE(fs::is_directory(dir + "/new/sub"));
+  EXPECT_TRUE(hidden_files(dir + "/new/sub").empty());  // the probe is gone
+  require_writable_file(dir + "/new/out.txt");
+  EXPECT_FALSE(fs::exists(dir + "/new/out.txt"));
+  const auto refused = [](const std::function<void()>& check, const std::string& message) {
+    try {
+      check();
+      ADD_FAILURE() << "accepted; expected: " << message;
+    } catch (const InvalidInputError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(message, 0), 0u) << e.what();
+    }
+  };
+  // A file where a folder is expected.
+  std::ofstream(dir + "/plain") << "x\n";
+  refused([&] { require_writable_folder(dir + "/plain/sub"); },
+          "cannot write into the folder '" + dir + "/plain/sub': ");
+  refused([&] { require_writable_folder(dir + "/plain"); },
+          "cannot write into the folder '" + dir + "/plain': ");
+  refused([&] { require_writable_file(dir + "/plain/out.txt"); },
+          "cannot write into the folder '" + dir + "/plain': ");
+  // A folder as an output file.
+  refused([&] { require_writable_file(dir + "/new"); },
+          "cannot write '" + dir + "/new': it is a folder");
+  // An existing folder in which no file can be created: without write permission, or for root
+  // (whom permissions do not stop) /proc.
+  std::string locked = "/proc";
+  if (geteuid() != 0) {
+    locked = dir + "/locked";
+    fs::create_directories(locked);
+    fs::permissions(locked, fs::perms::owner_read | fs::perms::owner_exec);
+  }
+  refused([&] { require_writable_folder(locked); },
+          "cannot write into the folder '" + locked + "': ");
+  refused([&] { require_writable_file(locked + "/out.txt"); },
+          "cannot write into the folder '" + locked + "': ");
 }
 
 }  // namespace

@@ -380,5 +380,41 @@ TEST(Validate, IsolatedNodeAndDuplicateIds) {
   EXPECT_TRUE(has_issue(r, "duplicate_id")) << dump(r);
 }
 
+// Issue #44 (6): a layout with thousands of nodes on shared vertices lists the first
+// kMaxListedIssuesPerCode issues of each kind and one summary per kind with the count of the
+// rest; the error count still counts every issue.
+TEST(Validate, RepeatedIssuesAreSummarizedPerKind) {
+  auto [mesh, layout] = test::cube_sphere(4);
+  const int shared = 3000, out_of_range = 30;
+  for (int i = 0; i < shared; ++i)  // every one on the vertex of node 0
+    layout.nodes.push_back(test::make_node(1000 + i, layout.nodes[0].vertex));
+  for (int i = 0; i < out_of_range; ++i)
+    layout.nodes.push_back(test::make_node(5000 + i, static_cast<int>(mesh.n_vertices()) + i));
+  const auto r = validate_layout(mesh, layout);
+  EXPECT_EQ(r.errors(), shared + out_of_range) << dump(r);
+  for (const auto& [code, count] : std::vector<std::pair<std::string, int>>{
+           {"nodes_share_vertex", shared}, {"bad_vertex", out_of_range}}) {
+    int listed = 0, summaries = 0, omitted = 0;
+    for (const auto& i : r.issues) {
+      if (i.code != code) continue;
+      EXPECT_EQ(i.severity, IssueSeverity::Error);
+      if (i.omitted > 0) {
+        ++summaries;
+        omitted += i.omitted;
+        EXPECT_EQ(format_issue(i), "error [" + code + "] … and " +
+                                       std::to_string(count - kMaxListedIssuesPerCode) +
+                                       " more of the same kind");
+      } else {
+        ++listed;
+        EXPECT_FALSE(i.node_ids.empty()) << format_issue(i);
+      }
+    }
+    EXPECT_EQ(listed, kMaxListedIssuesPerCode) << code;
+    EXPECT_EQ(summaries, 1) << code;
+    EXPECT_EQ(listed + omitted, count) << code;
+  }
+  EXPECT_LE(r.issues.size(), 2u * (kMaxListedIssuesPerCode + 1));
+}
+
 }  // namespace
 }  // namespace qs

@@ -8,12 +8,16 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <map>
 
 #include "core/base/errors.h"
 #include "core/layout/patch_import.h"
 #include "core/layout/validate.h"
 #include "core/mesh/closest_point.h"
+#include "core/mesh/mesh_checks.h"
 #include "core/mesh/mesh_io.h"
+#include "core/mesh/weld.h"
+#include "core/mesh/write_checks.h"
 #include "tests/fixtures.h"
 
 namespace qs {
@@ -171,6 +175,185 @@ TEST(QuadImportCli, WritesMeshAndLayoutAndRejectsBadInput) {
             2)
       << output;
   EXPECT_NE(output.find("does not lie on the target mesh"), std::string::npos) << output;
+}
+
+// ---- the importer's checks of its input and output (issue #44) ----
+
+// quad_cube(4) with the grid lines x = 1 and y = 1 moved to 2 − w: on the sides z = 0 and z = 4
+// the two thin strips cross in a w × w quad, of area 2.25e-12 for w = 1.5e-6: above the
+// readers' zero-area bound (1e-14 × diagonal² = 4.8e-13), but its triangles at refine 3
+// (area / 18) are below it.
+PolyMesh thin_cross_cube() {
+  PolyMesh quads = quad_cube(4);
+  const double w = 1.5e-6;
+  for (const auto v : quads.vertices()) {
+    Vec3 p = quads.point(v);
+    for (int axis : {0, 1})
+      if (p[axis] == 1) p[axis] = 2 - w;
+    quads.set_point(v, p);
+  }
+  return quads;
+}
+
+// Writes \p mesh as OBJ split into groups of \p group_size consecutive faces ("g part<i>"),
+// each group with its own copies of its vertices, as Blender exports a mesh split by face
+// groups. \p shift moves the copies of every second group (to test the weld tolerance).
+void write_split_obj(const PolyMesh& mesh, int group_size, const std::string& path,
+                     double shift = 0) {
+  std::ofstream out(path);
+  out.precision(17);
+  int base = 1;
+  const int faces = static_cast<int>(mesh.n_faces());
+  for (int group = 0; group * group_size < faces; ++group) {
+    out << "g part" << group << "\n";
+    std::map<int, int> local;
+    std::string lines;
+    for (int f = group * group_size; f < std::min(faces, (group + 1) * group_size); ++f) {
+      lines += "f";
+      for (const auto v : mesh.fv_range(mesh.face_handle(f))) {
+        if (!local.count(v.idx())) {
+          local.emplace(v.idx(), base + static_cast<int>(local.size()));
+          const Vec3 p = mesh.point(v) + Vec3(group % 2 ? shift : 0, 0, 0);
+          out << "v " << p[0] << " " << p[1] << " " << p[2] << "\n";
+        }
+        lines += " " + std::to_string(local.at(v.idx()));
+      }
+      lines += "\n";
+    }
+    out << lines;
+    base += static_cast<int>(local.size());
+  }
+}
+
+TEST(QuadImport, TriangulationTheReadersRejectIsAnError) {
+  const PolyMesh quads = thin_cross_cube();
+  std::vector<int> tiny;  // the two w × w quads
+  for (const auto f : quads.faces()) {
+    std::vector<Vec3> c;
+    for (const auto v : quads.fv_range(f)) c.push_back(quads.point(v));
+    if ((c[2] - c[0]).norm() < 1e-5) tiny.push_back(f.idx());  // diagonal w·√2
+  }
+  ASSERT_EQ(tiny.size(), 2u);
+  QuadImportOptions options;
+  options.all_edges = true;
+  options.refine = 3;
+  try {
+    import_quads(quads, nullptr, options);
+    FAIL() << "a triangulation with zero-area triangles was accepted";
+  } catch (const InvalidInputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("would be rejected when read back"), std::string::npos) << what;
+    EXPECT_NE(what.find("36 degenerate faces"), std::string::npos) << what;  // 2 × 2 · 3²
+    EXPECT_NE(what.find("the degenerate triangles lie in quads " + std::to_string(tiny[0]) + ", " +
+                        std::to_string(tiny[1]) + ":"),
+              std::string::npos)
+        << what;
+  }
+  options.refine = 1;
+  const QuadImportResult r = import_quads(quads, nullptr, options);
+  EXPECT_TRUE(check_as_read(r.mesh).ok());
+  expect_matches_complex(r, "thin cross, refine 1");
+}
+
+TEST(QuadImportCli, NeverWritesAMeshTheReadersReject) {
+  const std::string dir = test::temp_dir("import_quads_cli_thin");
+  test::write_obj(thin_cross_cube(), dir + "/thin.obj");
+  std::string output;
+  const std::string import =
+      test::cli_path() + " import-quads --quads " + dir + "/thin.obj --all-edges --out ";
+  EXPECT_EQ(test::run_command(import + dir + "/r3 --refine 3", &output), 2) << output;
+  EXPECT_NE(output.find("would be rejected when read back"), std::string::npos) << output;
+  EXPECT_NE(output.find("the degenerate triangles lie in quads"), std::string::npos) << output;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/r3/mesh.obj"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/r3/layout.json"));
+  // At refine 1 the triangles are large enough, and the mesh written validates.
+  ASSERT_EQ(test::run_command(import + dir + "/r1", &output), 0) << output;
+  EXPECT_EQ(test::run_command(test::cli_path() + " validate --mesh " + dir + "/r1/mesh.obj" +
+                                  " --layout " + dir + "/r1/layout.json",
+                              &output),
+            0)
+      << output;
+}
+
+// A cube exported per side (6 parts, each with its own 9 vertices) is one surface again after
+// welding: 54 − 26 = 28 vertices go. Copies apart by more than the tolerance stay apart.
+TEST(QuadImport, WeldingJoinsAQuadMeshExportedPerPatch) {
+  const std::string dir = test::temp_dir("quad_import_weld");
+  const PolyMesh cube = quad_cube(2);
+  write_split_obj(cube, 4, dir + "/split.obj");
+  const WeldedPolyMesh loaded = load_poly_mesh_welded(dir + "/split.obj");
+  EXPECT_EQ(loaded.welded, 28);
+  EXPECT_EQ(loaded.parts_before, 6);
+  EXPECT_EQ(loaded.mesh.n_vertices(), 26u);
+  EXPECT_EQ(loaded.report.components, 1);
+  ASSERT_EQ(loaded.mesh.n_faces(), cube.n_faces());
+  const auto corners = [](const PolyMesh& mesh, int f) {
+    std::vector<Vec3> points;
+    for (const auto v : mesh.fv_range(mesh.face_handle(f))) points.push_back(mesh.point(v));
+    return points;
+  };
+  for (int f = 0; f < static_cast<int>(cube.n_faces()); ++f)  // same corners, same order
+    EXPECT_EQ(corners(cube, f), corners(loaded.mesh, f)) << "face " << f;
+  // Within the tolerance (1e-9 × diagonal 6.9): welded; beyond it: 6 parts remain.
+  write_split_obj(cube, 4, dir + "/near.obj", 1e-12);
+  EXPECT_EQ(load_poly_mesh_welded(dir + "/near.obj").welded, 28);
+  write_split_obj(cube, 4, dir + "/apart.obj", 1e-6);
+  try {
+    load_poly_mesh_welded(dir + "/apart.obj");
+    FAIL() << "parts 1e-6 apart were welded";
+  } catch (const InvalidInputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("connected components (expected 1)"), std::string::npos) << what;
+  }
+}
+
+// When the welded mesh is still rejected, the error says that the parts touch at coincident
+// vertices: two cubes sharing one corner become one part with a non-manifold vertex.
+TEST(QuadImport, WeldingThatIsNotEnoughSaysWhereThePartsTouch) {
+  const std::string dir = test::temp_dir("quad_import_weld_corner");
+  PolyMesh two = quad_cube(1);
+  const PolyMesh other = quad_cube(1, Vec3(1, 1, 1));
+  std::vector<OpenMesh::VertexHandle> map;
+  for (const auto v : other.vertices()) map.push_back(two.add_vertex(other.point(v)));
+  for (const auto f : other.faces()) {
+    std::vector<OpenMesh::VertexHandle> face;
+    for (const auto v : other.fv_range(f)) face.push_back(map[v.idx()]);
+    two.add_face(face);
+  }
+  test::write_obj(two, dir + "/corner.obj");
+  try {
+    load_poly_mesh_welded(dir + "/corner.obj");
+    FAIL() << "two cubes sharing a corner were accepted";
+  } catch (const InvalidInputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("after welding 1 coincident vertices, at which the file's 2 separate "
+                        "parts touch"),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("non-manifold vert"), std::string::npos) << what;
+  }
+}
+
+TEST(QuadImportCli, WeldsAQuadMeshExportedPerPatch) {
+  const std::string dir = test::temp_dir("import_quads_cli_weld");
+  write_split_obj(quad_cube(2), 4, dir + "/split.obj");
+  std::string output;
+  ASSERT_EQ(test::run_command(test::cli_path() + " import-quads --quads " + dir +
+                                  "/split.obj --all-edges --out " + dir + "/out",
+                              &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("note: " + dir + "/split.obj: welded 28 coincident vertices"),
+            std::string::npos)
+      << output;
+  EXPECT_NE(output.find("joining 6 separate parts"), std::string::npos) << output;
+  EXPECT_EQ(test::run_command(test::cli_path() + " validate --mesh " + dir + "/out/mesh.obj" +
+                                  " --layout " + dir + "/out/layout.json",
+                              &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("26 nodes"), std::string::npos) << output;
+  EXPECT_NE(output.find("24 patches"), std::string::npos) << output;
 }
 
 // ---- real inputs (../shared) ----

@@ -1,20 +1,26 @@
 // quadsketch-cli: the headless interface (interfaces.md §2).
-// Exit codes: 0 success; 2 invalid input; 3 solver failure; 1 anything else.
+// Exit codes: 0 success; 2 invalid input; 3 solver failure; 1 anything else (a malformed or
+// out-of-range option, out of memory, a write error).
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <iostream>
+#include <new>
 #include <string>
 
+#include "app/cli/activity.h"
 #include "app/cli/commands.h"
 #include "app/cli/signals.h"
+#include "app/cli/validators.h"
 #include "core/base/allocator.h"
 #include "core/base/errors.h"
 #include "core/base/solver_threads.h"
 
-int main(int argc, char** argv) {
-  // First of all, so that a signal during start-up is never handled by the default action.
-  qs::cli::install_signal_handlers();  // SIGINT/SIGTERM: cancel, report.json "cancelled", 130/143
-  qs::limit_solver_threads_here();     // CHOLMOD's OpenMP regions: at most the idle cores
-  qs::keep_freed_memory();             // solves reuse freed memory (core/base/allocator.h)
+namespace {
+
+// The command line: sets up and parses the options, runs the subcommand.
+int run_cli(int argc, char** argv) {
+  qs::limit_solver_threads_here();  // CHOLMOD's OpenMP regions: at most the idle cores
+  qs::keep_freed_memory();          // solves reuse freed memory (core/base/allocator.h)
   using namespace qs::cli;
   CLI::App app{"QuadSketch: quad layout embedding via aligned parameterization (headless)",
                "quadsketch-cli"};
@@ -32,13 +38,20 @@ int main(int argc, char** argv) {
   cmd_validate->add_option("--layout", validate.layout, "Layout JSON")->required();
   cmd_validate->add_option("--out", validate.out, "Also write report.json into this folder");
 
+  // field and optimize: the dihedral angle above which an edge is sharp.
+  auto add_sharp_angle_option = [](CLI::App* cmd, double& value) {
+    cmd->add_option("--sharp-angle", value, "Sharp feature dihedral angle (deg)")
+        ->check(finite_in(0, 180))
+        ->capture_default_str();
+  };
+
   // field and optimize: CrossFieldOptions::max_cluster_faces.
   auto add_cluster_option = [](CLI::App* cmd, int& value) {
     cmd->add_option("--max-cluster-faces", value,
                     "Curvature constraints form clusters of at most N faces, each with its own "
                     "quarter-turn rotation, released one by one where they contradict the "
                     "layout (0: whole connected regions)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(finite_in(0, 1e9))
         ->capture_default_str();
   };
 
@@ -56,9 +69,7 @@ int main(int argc, char** argv) {
   cmd_field->add_option("--mesh", field.mesh, "Triangle mesh")->required();
   cmd_field->add_option("--layout", field.layout, "Layout JSON")->required();
   cmd_field->add_option("--out", field.out, "Output folder")->required();
-  cmd_field
-      ->add_option("--sharp-angle", field.sharp_angle_deg, "Sharp feature dihedral angle (deg)")
-      ->capture_default_str();
+  add_sharp_angle_option(cmd_field, field.sharp_angle_deg);
   add_cluster_option(cmd_field, field.max_cluster_faces);
   add_free_holes_option(cmd_field, field.wrap_free_holes);
 
@@ -71,15 +82,20 @@ int main(int argc, char** argv) {
       ->add_option("--steps", opt.steps,
                    "Node optimization descent steps (accepted and rejected) before the first hop "
                    "sweep; a sweep that moves nodes allows at least 10 more (3 sweeps at most)")
+      ->check(finite_in(0, 10000))
       ->capture_default_str();
   cmd_opt->add_flag("--no-node-opt", opt.no_node_opt, "Only field and parameterization");
   auto* quad_size_opt =
-      cmd_opt->add_option("--quad-size", opt.quad_size,
-                          "Write quads.obj, patches.json, layout_curves.obj with this quad size");
+      cmd_opt
+          ->add_option("--quad-size", opt.quad_size,
+                       "Write quads.obj, patches.json, layout_curves.obj with this quad size "
+                       "(refused when the quad mesh would have more than " +
+                           std::to_string(kMaxQuads) + " quads)")
+          ->check(positive_finite());
   cmd_opt
       ->add_option("--quad-count", opt.quad_count,
                    "Like --quad-size, choosing the size for about N quads")
-      ->check(CLI::PositiveNumber)
+      ->check(finite_in(1, kMaxQuads))
       ->excludes(quad_size_opt);
   cmd_opt->add_flag("--integer", opt.integer,
                     "Make every patch size an integer multiple of the quad size: optimize relaxed, "
@@ -102,14 +118,7 @@ int main(int argc, char** argv) {
                    "Stop moving nodes after this many seconds (wall clock, from the start of the "
                    "node optimization; with --integer both runs together) and finish from the "
                    "state reached (the continuous run still removes fold-overs)")
-      ->check(CLI::Validator(
-          [](std::string& text) -> std::string {
-            double value = 0;
-            return CLI::detail::lexical_cast(text, value) && value > 0
-                       ? ""
-                       : "must be a positive number of seconds, got " + text;
-          },
-          "SECONDS > 0"));
+      ->check(positive_finite(1e7, "a positive number of seconds"));
   cmd_opt->add_flag("--no-sliding", opt.no_sliding,
                     "Nodes on the boundary and on feature curves stay instead of sliding along "
                     "them; nodes on sharp edges move freely and vertices on sharp edges may be "
@@ -165,8 +174,7 @@ int main(int argc, char** argv) {
           "--no-sizing", [&opt] { opt.sizing = false; },
           "Unit targets, no sizing field, and no retry with it when fold-overs remain")
       ->excludes(sizing_on);
-  cmd_opt->add_option("--sharp-angle", opt.sharp_angle_deg, "Sharp feature dihedral angle (deg)")
-      ->capture_default_str();
+  add_sharp_angle_option(cmd_opt, opt.sharp_angle_deg);
   add_cluster_option(cmd_opt, opt.max_cluster_faces);
   add_free_holes_option(cmd_opt, opt.wrap_free_holes);
   cmd_opt
@@ -185,19 +193,21 @@ int main(int argc, char** argv) {
                        "Use every edge as an arc (coarse cages) instead of the base complex");
   cmd_import
       ->add_option("--refine", imp.refine, "Split each quad K x K before triangulating (no --onto)")
-      ->check(CLI::PositiveNumber)
+      ->check(finite_in(1, 1000))
       ->capture_default_str();
   cmd_import
       ->add_option("--coarsen", imp.coarsen,
                    "Collapse the base complex's patch strips thinner than W mean edge lengths")
-      ->check(CLI::NonNegativeNumber)
+      ->check(finite_in(0, 1e6))
       ->capture_default_str();
 
   PerturbOptions perturb;
   auto* cmd_perturb = app.add_subcommand("perturb", "Move the nodes of a layout randomly");
   cmd_perturb->add_option("--mesh", perturb.mesh, "Triangle mesh")->required();
   cmd_perturb->add_option("--layout", perturb.layout, "Layout JSON")->required();
-  cmd_perturb->add_option("--rings", perturb.rings, "Edge rings to move each node")->required();
+  cmd_perturb->add_option("--rings", perturb.rings, "Edge rings to move each node")
+      ->check(finite_in(1, 1000))
+      ->required();
   cmd_perturb->add_option("--seed", perturb.seed, "Random seed")->required();
   cmd_perturb->add_option("--out", perturb.out, "Output layout JSON")->required();
 
@@ -213,17 +223,17 @@ int main(int argc, char** argv) {
                      "Every cage edge is an arc (one patch per cage quad) instead of the base "
                      "complex");
   cmd_cage->add_option("--smoothing", cage.smoothing, "Spring relaxation rounds of the fitted cage")
-      ->check(CLI::NonNegativeNumber)
+      ->check(finite_in(0, 10000))
       ->capture_default_str();
   cmd_cage
       ->add_option("--attempts", cage.attempts,
                    "Grids to try (resolution, shifted, resolution + 1, ...) until one works")
-      ->check(CLI::PositiveNumber)
+      ->check(finite_in(1, 400))
       ->capture_default_str();
   cmd_cage
       ->add_option("--coarsen", cage.coarsen,
                    "Collapse cage chords at most this many voxel cells wide (0: off)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(finite_in(0, 1000))
       ->capture_default_str();
   cmd_cage
       ->add_option("--subsamples", cage.subsamples,
@@ -236,6 +246,7 @@ int main(int argc, char** argv) {
                      "collapses, edge rotations) and re-embed it; falls back to the plain layout");
   cmd_cage->add_option("--cage", cage.cage, "Also write the fitted quad cage (OBJ)");
 
+  set_activity("parsing the command line");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -247,6 +258,7 @@ int main(int argc, char** argv) {
   // commands are short and write atomically: a signal simply ends them.
   if (!*cmd_field && !*cmd_opt) restore_default_signal_handling();
   try {
+    set_activity("running " + app.get_subcommands().front()->get_name());
     if (*cmd_validate) return run_validate(validate, common);
     if (*cmd_field) return run_field(field, common);
     if (*cmd_opt) return run_optimize(opt, common);
@@ -256,9 +268,27 @@ int main(int argc, char** argv) {
   } catch (const qs::Cancelled&) {
     std::cerr << "error: cancelled (" << signal_name(received_signal()) << ")\n";
     return cancelled_exit_code();
+  } catch (const std::bad_alloc&) {
+    throw;  // main() ends the process
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return qs::exit_code_for(e);
   }
   return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // First of all, so that a signal during start-up is never handled by the default action.
+  qs::cli::install_signal_handlers();  // SIGINT/SIGTERM: cancel, report.json "cancelled", 130/143
+  // A file-size limit (ulimit -f) fails the write (EFBIG, reported) instead of killing.
+  std::signal(SIGXFSZ, SIG_IGN);
+  // Out of memory anywhere: "error: out of memory while <activity>", exit code 1.
+  qs::cli::handle_out_of_memory_in_terminate();
+  try {
+    return run_cli(argc, argv);
+  } catch (const std::bad_alloc&) {
+    qs::cli::exit_out_of_memory();
+  }
 }

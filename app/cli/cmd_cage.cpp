@@ -1,6 +1,5 @@
 // quadsketch-cli cage-layout: a quad layout for a closed triangle mesh from its voxel cage.
 #include <chrono>
-#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -9,10 +8,12 @@
 #include "app/cli/commands.h"
 #include "app/cli/report.h"
 #include "core/base/atomic_file.h"
+#include "core/base/errors.h"
 #include "core/layout/cage.h"
 #include "core/layout/layout_io.h"
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_io.h"
+#include "core/mesh/write_checks.h"
 
 namespace qs::cli {
 
@@ -43,6 +44,8 @@ std::string format_shift(double shift) {
 
 int run_cage_layout(const CageLayoutOptions& o, const CommonOptions& common) {
   const auto t0 = std::chrono::steady_clock::now();
+  require_writable_file(o.out);
+  if (!o.cage.empty()) require_writable_file(o.cage);
   const TriMesh mesh = load_mesh_printing_warnings(o.mesh);
   CageOptions options;
   options.resolution = o.resolution;
@@ -52,16 +55,19 @@ int run_cage_layout(const CageLayoutOptions& o, const CommonOptions& common) {
   options.fit.iterations = o.smoothing;
   options.subsamples = o.subsamples;
   options.simplify = o.simplify;
+  set_activity("making the cage layout");
   const CageResult result = cage_layout(mesh, options);
   for (const auto& w : result.warnings) std::cerr << "warning: " << w << "\n";
-  const auto parent = std::filesystem::path(o.out).parent_path();
-  if (!parent.empty()) std::filesystem::create_directories(parent);
-  save_layout(result.layout, o.out, &mesh);
+  // The layout was validated by the transfer (the checks load_layout applies); the cage gets
+  // the checks of the mesh reader before anything is written.
   if (!o.cage.empty()) {
-    const auto cage_parent = std::filesystem::path(o.cage).parent_path();
-    if (!cage_parent.empty()) std::filesystem::create_directories(cage_parent);
-    write_cage_obj(result.cage, o.cage);
+    const MeshReport cage_report = check_as_read(result.cage);
+    if (!cage_report.ok())
+      throw InvalidInputError(rejection_message(cage_report, "the fitted cage for " + o.cage));
   }
+  set_activity("writing " + o.out);
+  save_layout(result.layout, o.out, &mesh);
+  if (!o.cage.empty()) write_cage_obj(result.cage, o.cage);
   if (!common.quiet) {
     const nlohmann::json counts = layout_json(build_topology(mesh, result.layout));
     std::cerr << "cage-layout: resolution " << result.resolution

@@ -15,6 +15,7 @@
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_checks.h"
 #include "core/mesh/mesh_io.h"
+#include "core/mesh/weld.h"
 
 namespace qs::cli {
 
@@ -41,18 +42,30 @@ std::string ids_text(const std::vector<int>& ids, size_t max_count = 20) {
 }  // namespace
 
 int run_import_quads(const ImportQuadsOptions& o, const CommonOptions& common) {
-  std::filesystem::create_directories(o.out);
+  require_writable_folder(o.out);
   const std::string report_path = (std::filesystem::path(o.out) / "report.json").string();
   nlohmann::json report;
   try {
     const auto t_total = std::chrono::steady_clock::now();
-    MeshReport quad_report;
-    const PolyMesh quads = load_poly_mesh(o.quads, &quad_report);
-    for (const auto& w : quad_report.warnings)
+    // Coincident vertices are welded first: a quad mesh exported per patch (each patch with
+    // its own copies of its border vertices) is one surface again.
+    set_activity("loading the quad mesh '" + o.quads + "'");
+    const WeldedPolyMesh loaded = load_poly_mesh_welded(o.quads, kWeldTolerance);
+    const PolyMesh& quads = loaded.mesh;
+    for (const auto& w : loaded.report.warnings)
       std::cerr << "warning: " << o.quads << ": " << w << "\n";
+    if (loaded.welded > 0 && !common.quiet) {
+      std::cerr << "note: " << o.quads << ": welded " << loaded.welded
+                << " coincident vertices (closer than " << kWeldTolerance
+                << " x the bounding-box diagonal)";
+      if (loaded.parts_before > 1)
+        std::cerr << ", joining " << loaded.parts_before << " separate parts";
+      std::cerr << "\n";
+    }
     TriMesh target;
     MeshReport target_report;
     if (!o.onto.empty()) {
+      set_activity("loading the target mesh '" + o.onto + "'");
       target = load_mesh(o.onto, &target_report);
       for (const auto& w : target_report.warnings)
         std::cerr << "warning: " << o.onto << ": " << w << "\n";
@@ -84,11 +97,13 @@ int run_import_quads(const ImportQuadsOptions& o, const CommonOptions& common) {
       }
     }
     const auto t_import = std::chrono::steady_clock::now();
+    set_activity("importing the quad mesh '" + o.quads + "'");
     const QuadImportResult result =
         import_quads(quads, o.onto.empty() ? nullptr : &target, options);
     const double import_s = seconds_since(t_import);
     for (const auto& w : result.warnings) std::cerr << "warning: " << o.quads << ": " << w << "\n";
 
+    set_activity("writing " + o.out + "/mesh.obj and layout.json");
     save_mesh_obj(result.mesh, (std::filesystem::path(o.out) / "mesh.obj").string());
     save_layout(result.layout, (std::filesystem::path(o.out) / "layout.json").string(),
                 &result.mesh);
@@ -101,6 +116,7 @@ int run_import_quads(const ImportQuadsOptions& o, const CommonOptions& common) {
                       {"boundaries", out_report.boundary_loops}};
     report["layout"] = layout_counts(result.mesh, result.layout);
     report["quads"] = {{"vertices", result.quads.n_vertices()},
+                       {"welded_vertices", loaded.welded},
                        {"faces", result.quads.n_faces()},
                        {"irregular_vertices", result.complex.irregular_vertices},
                        {"split", result.split},
@@ -146,7 +162,7 @@ int run_import_quads(const ImportQuadsOptions& o, const CommonOptions& common) {
     return 0;
   } catch (const std::exception& e) {
     report["status"] = "failed";
-    report["message"] = e.what();
+    report["message"] = failure_message(e);
     try {
       write_file_atomic(report_path, report.dump(2) + "\n");
     } catch (...) {
@@ -157,14 +173,17 @@ int run_import_quads(const ImportQuadsOptions& o, const CommonOptions& common) {
 
 int run_perturb(const PerturbOptions& o, const CommonOptions& common) {
   const auto t0 = std::chrono::steady_clock::now();
+  require_writable_file(o.out);
   const TriMesh mesh = load_mesh_printing_warnings(o.mesh);
+  set_activity("loading the layout '" + o.layout + "'");
   const Layout layout = load_layout(o.layout, mesh);
   PerturbLayoutOptions options;
   options.rings = o.rings;
   options.seed = o.seed;
+  // perturb_layout validates its result (the checks load_layout applies) before it is written.
+  set_activity("perturbing the layout");
   const PerturbResult result = perturb_layout(mesh, layout, options);
-  const auto parent = std::filesystem::path(o.out).parent_path();
-  if (!parent.empty()) std::filesystem::create_directories(parent);
+  set_activity("writing " + o.out);
   save_layout(result.layout, o.out, &mesh);
   if (!result.stuck_nodes.empty()) {
     std::cerr << "warning: " << result.stuck_nodes.size()

@@ -3,9 +3,12 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "app/cli/commands.h"
@@ -78,6 +81,24 @@ void warn_about_infeasible_orientation(const OrientationReport& r, int foldovers
   std::cerr << ": " << r.message << "\n";
 }
 
+// Refuses a quad size that would give more than kMaxQuads quads. \p quads: the count, found as
+// \p basis says.
+void require_quad_count_within_limit(double quads, double quad_size, const std::string& basis) {
+  if (quads <= static_cast<double>(kMaxQuads)) return;
+  std::ostringstream os;
+  os << std::setprecision(3) << "--quad-size " << quad_size << " would make " << quads << " quads ("
+     << basis << "), more than the limit of " << kMaxQuads << "; use a --quad-size of at least "
+     << quad_size * std::sqrt(quads / static_cast<double>(kMaxQuads)) << " (or --quad-count)";
+  throw InvalidInputError(os.str());
+}
+
+// Total area of the mesh's faces (length²).
+double surface_area(const TriMesh& mesh) {
+  double area = 0;
+  for (const auto f : mesh.faces()) area += mesh.calc_face_area(f);
+  return area;
+}
+
 }  // namespace
 
 int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
@@ -87,9 +108,19 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     const auto t_total = std::chrono::steady_clock::now();
     auto t0 = t_total;
     MeshReport mesh_report;
+    set_activity("loading the mesh '" + o.mesh + "'");
     TriMesh mesh = load_mesh(o.mesh, &mesh_report);
+    set_activity("loading the layout '" + o.layout + "'");
     Layout layout = load_layout(o.layout, mesh);
     report["mesh"] = mesh_json(mesh_report);
+    // A parameterization close to isometric has about the surface's area: refuse an absurd
+    // quad size now rather than after the whole optimization.
+    if (o.quad_size > 0) {
+      const double area = surface_area(mesh);
+      std::ostringstream basis;
+      basis << std::setprecision(3) << "estimated: surface area " << area << " / quad size²";
+      require_quad_count_within_limit(area / (o.quad_size * o.quad_size), o.quad_size, basis.str());
+    }
     const double load_s = seconds_since(t0);
     PipelineOptions options;
     options.field.constraints.sharp_angle_deg = o.sharp_angle_deg;
@@ -193,6 +224,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     nlohmann::json sizing_retry, apart_retry;
     if (!o.no_node_opt) {
       t0 = std::chrono::steady_clock::now();
+      set_activity("optimizing the nodes");
       const bool may_retry_apart =
           !o.keep_nodes_apart && !o.discrete_relocation && !o.no_orientation;
       const bool may_retry =
@@ -336,6 +368,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     else
       solved = std::make_shared<Pipeline>(std::move(mesh), std::move(layout), options);
     Pipeline& pipeline = *solved;
+    set_activity("computing the final field, parameterization and extraction");
     report["layout"] = layout_json(pipeline.topology());
     t0 = std::chrono::steady_clock::now();
     const CrossField& field = pipeline.field() ? *pipeline.field() : pipeline.compute_field();
@@ -454,6 +487,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
                                   {"sizing", options.param.sizing.enabled},
                                   {"aligned", !o.no_align}};
     const fs::path out(o.out);
+    set_activity("writing the results into " + o.out);
     write_param_obj(pipeline.mesh(), param.corner_uv, (out / "param.obj").string());
     write_field_txt(pipeline.geometry(), field.theta, (out / "field.txt").string());
     save_layout(pipeline.output_layout(), (out / "layout.json").string(), &pipeline.mesh());
@@ -461,9 +495,16 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       QuadMeshOptions qo;
       qo.quad_size = integer ? integer->quad_size : o.quad_size;
       qo.quad_count = integer ? 0 : o.quad_count;
+      if (qo.quad_size > 0) {
+        require_quad_count_within_limit(
+            static_cast<double>(count_quads(pipeline.topology(), ex, qo.quad_size)), qo.quad_size,
+            "counted on the parameterization");
+      }
+      set_activity("building the quad mesh");
       const QuadMesh quads = build_quad_mesh(pipeline, ex, qo);
       UvAtlasOptions atlas;
       if (o.atlas == "packed") atlas.layout = UvAtlasLayout::kPacked;
+      set_activity("writing the quad mesh into " + o.out);
       write_quad_exports(quads, pipeline.output_layout(), ex, out.string(), atlas);
       report["quads"] = {{"quad_size", quads.quad_size},
                          {"vertices", quads.vertices.size()},

@@ -16,11 +16,16 @@
 namespace qs::cli {
 
 int run_validate(const ValidateOptions& o, const CommonOptions& common) {
+  if (!o.out.empty()) require_writable_folder(o.out);
+  set_activity("loading the mesh '" + o.mesh + "'");
   MeshReport report;
   const TriMesh mesh = load_mesh(o.mesh, &report);
   for (const auto& w : report.warnings) std::cerr << "warning: " << o.mesh << ": " << w << "\n";
+  set_activity("loading the layout '" + o.layout + "'");
   const Layout layout = load_layout(o.layout, mesh);
+  set_activity("validating the layout '" + o.layout + "'");
   const ValidationResult result = validate_layout(mesh, layout);
+  set_activity("reporting the issues of the layout '" + o.layout + "'");
   for (const auto& issue : result.issues)
     std::cerr << o.layout << ": " << format_issue(issue) << "\n";
 
@@ -36,6 +41,7 @@ int run_validate(const ValidateOptions& o, const CommonOptions& common) {
                       {"nodes", i.node_ids},
                       {"arcs", i.arc_ids},
                       {"vertices", i.vertices}});
+    if (i.omitted > 0) issues.back()["omitted"] = i.omitted;
   }
   out["issues"] = issues;
   if (result.valid()) {
@@ -59,7 +65,7 @@ int run_validate(const ValidateOptions& o, const CommonOptions& common) {
     std::cerr << o.layout << ": invalid layout: " << result.errors() << " error(s)\n";
   }
   if (!o.out.empty()) {
-    std::filesystem::create_directories(o.out);
+    set_activity("writing " + o.out + "/report.json");
     write_file_atomic((std::filesystem::path(o.out) / "report.json").string(), out.dump(2) + "\n");
   }
   return result.valid() ? 0 : 2;
@@ -70,7 +76,9 @@ int run_field(const FieldOptions& o, const CommonOptions& common) {
     const auto t_total = std::chrono::steady_clock::now();
     auto t0 = t_total;
     MeshReport mesh_report;
+    set_activity("loading the mesh '" + o.mesh + "'");
     TriMesh mesh = load_mesh(o.mesh, &mesh_report);
+    set_activity("loading the layout '" + o.layout + "'");
     Layout layout = load_layout(o.layout, mesh);
     report["mesh"] = mesh_json(mesh_report);
     const double load_s = seconds_since(t0);
@@ -78,6 +86,7 @@ int run_field(const FieldOptions& o, const CommonOptions& common) {
     options.field.constraints.sharp_angle_deg = o.sharp_angle_deg;
     options.field.max_cluster_faces = o.max_cluster_faces;
     if (o.wrap_free_holes) options.field.free_loops = FreeLoopTurning::kWrap;
+    set_activity("computing the cross field");
     Pipeline pipeline(std::move(mesh), std::move(layout), options);
     report["layout"] = layout_json(pipeline.topology());
     t0 = std::chrono::steady_clock::now();
@@ -92,6 +101,7 @@ int run_field(const FieldOptions& o, const CommonOptions& common) {
     report["period_jumps"] = {{"free_unknowns", field.topology.free_unknowns},
                               {"layout_cycles", field.topology.cycles},
                               {"max_abs", field.topology.max_abs_jump}};
+    set_activity("writing " + o.out + "/field.txt");
     write_field_txt(pipeline.geometry(), field.theta,
                     (std::filesystem::path(o.out) / "field.txt").string());
     report["timings_s"] = {{"load", load_s},

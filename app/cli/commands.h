@@ -1,5 +1,7 @@
 // The subcommands of quadsketch-cli. Each returns the process exit code and may throw
-// qs::QsError (mapped to exit codes by qs::exit_code_for).
+// qs::QsError (mapped to exit codes by qs::exit_code_for). Each checks that its outputs can be
+// written (require_writable_folder / require_writable_file) before it computes anything, and
+// records what it is doing (set_activity) for the message of an allocation failure.
 #pragma once
 
 #include <optional>
@@ -8,6 +10,11 @@
 #include "core/field/cross_field.h"
 
 namespace qs::cli {
+
+//! optimize refuses to build a quad mesh with more quads (about 1.7 GB of quads.obj), estimated
+//! from the surface area / quad size² before the computation and counted before the quad mesh
+//! is built.
+inline constexpr long kMaxQuads = 10'000'000;
 
 struct CommonOptions {
   bool quiet = false;
@@ -59,6 +66,9 @@ struct OptimizeOptions {
   //! Wall-clock seconds for moving nodes (all node optimization runs together); 0: no limit.
   double time_limit_s = 0;
 };
+
+//! import-quads welds the quad mesh's vertices closer than this × its bounding-box diagonal.
+inline constexpr double kWeldTolerance = 1e-9;
 
 struct ImportQuadsOptions {
   std::string quads, onto, out;

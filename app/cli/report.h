@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "app/cli/activity.h"
 #include "app/cli/signals.h"
 #include "core/base/atomic_file.h"
 #include "core/base/errors.h"
@@ -21,6 +22,7 @@ namespace qs::cli {
 //! Loads a mesh for a command that writes no report: its warnings go to stderr, prefixed by
 //! the file name. \throw InvalidInputError as load_mesh.
 inline TriMesh load_mesh_printing_warnings(const std::string& path) {
+  set_activity("loading the mesh '" + path + "'");
   MeshReport report;
   TriMesh mesh = load_mesh(path, &report);
   for (const auto& w : report.warnings) std::cerr << "warning: " << path << ": " << w << "\n";
@@ -67,13 +69,15 @@ inline bool warn_about_released_constraints(const CrossField& field, const std::
   return !w.empty();
 }
 
-//! Runs a command that writes into an output folder: report.json is written also on failure,
-//! with "status": "failed" and the message, before the error propagates. On SIGINT/SIGTERM
-//! (signals.h) the status is "cancelled" and qs::Cancelled propagates (exit code 128 + signal);
-//! a stage that does not poll for cancellation is stopped by a CancelWatchdog.
+//! Runs a command that writes into an output folder: the folder is created and checked for
+//! writability first (require_writable_folder, before \p body computes anything), report.json
+//! is written also on failure, with "status": "failed" and the message (failure_message),
+//! before the error propagates. On SIGINT/SIGTERM (signals.h) the status is "cancelled" and
+//! qs::Cancelled propagates (exit code 128 + signal); a stage that does not poll for
+//! cancellation is stopped by a CancelWatchdog.
 template <typename Body>
 int with_report(const std::string& out_dir, Body&& body) {
-  std::filesystem::create_directories(out_dir);
+  require_writable_folder(out_dir);
   // Temporary files of an earlier run that was killed outright (SIGKILL, power loss).
   remove_atomic_write_leftovers(out_dir);
   const std::string report_path = (std::filesystem::path(out_dir) / "report.json").string();
@@ -100,7 +104,7 @@ int with_report(const std::string& out_dir, Body&& body) {
   } catch (const std::exception& e) {
     watchdog.reset();
     report["status"] = "failed";
-    report["message"] = e.what();
+    report["message"] = failure_message(e);
     try {
       write_file_atomic(report_path, report.dump(2) + "\n");
     } catch (...) {

@@ -1,10 +1,19 @@
 // quadsketch: the layout editor (interfaces.md §3).
 #include <CLI/CLI.hpp>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <new>
 
 #include "app/gui/app.h"
 #include "core/base/allocator.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+// What the editor is doing, for the message of an allocation failure.
+const char* activity = "starting the editor";
+
+int run_editor(int argc, char** argv) {
   qs::keep_freed_memory();  // the worker's solves reuse freed memory (core/base/allocator.h)
   qs::app::AppOptions options;
   CLI::App cli("QuadSketch: sketch a quad layout on a triangle mesh and optimize it.");
@@ -49,5 +58,21 @@ int main(int argc, char** argv) {
   cli.add_option("--height", options.height, "Window height")->check(CLI::Range(200, 8192));
   CLI11_PARSE(cli, argc, argv);
   qs::app::App app(std::move(options));
+  activity = "running the editor";
   return app.run();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // An allocation failure that no part of the editor handles (it reports failed loads and runs
+  // itself) ends it with a message and exit code 1 instead of std::terminate; without exit
+  // handlers, which could wait for a library thread that never got its memory.
+  try {
+    return run_editor(argc, argv);
+  } catch (const std::bad_alloc&) {
+    std::fflush(stdout);
+    std::cerr << "quadsketch: error: out of memory while " << activity << std::endl;
+    std::_Exit(1);
+  }
 }

@@ -9,6 +9,7 @@
 #include "core/layout/base_complex.h"
 #include "core/layout/layout.h"
 #include "core/layout/patch_import.h"
+#include "core/layout/quad_triangulation.h"
 #include "core/mesh/mesh.h"
 
 namespace qs {
@@ -55,23 +56,6 @@ struct QuadImportResult {
   PatchLayoutStats partition_stats;
 };
 
-//! Triangulates a pure quad mesh, each quad first split refine × refine by bilinear
-//! interpolation of its corners, each small quad then cut along its shorter diagonal.
-//! Vertex order: the quad mesh's vertices (same indices), then refine − 1 points per edge (edge
-//! order, running from the edge's first halfedge's from-vertex), then (refine − 1)² per face
-//! (face order, row by row). Neighbouring quads share their edge points. 2·refine² triangles
-//! per quad, in quad order.
-//! \pre is_pure_quad(quads); refine >= 1. \throw InvalidInputError otherwise.
-TriMesh triangulate_quads(const PolyMesh& quads, int refine = 1);
-
-//! The vertex path on triangulate_quads(quads, refine) that runs along the quad-mesh vertex
-//! path \p path (each quad edge becomes refine mesh edges).
-//! \pre consecutive vertices of \p path are joined by quad-mesh edges.
-std::vector<int> refine_quad_path(const PolyMesh& quads, int refine, const std::vector<int>& path);
-
-//! The complex as a Layout on triangulate_quads(quads, refine): exact, no projection.
-Layout layout_on_triangulation(const PolyMesh& quads, const QuadComplex& complex, int refine);
-
 //! Transfers the complex onto another triangle mesh \p target lying near the quad mesh:
 //! nodes go to the closest surface point of \p target, snapped to the nearest free vertex of
 //! its face (or of that face's 1-ring, else up to 3 rings; boundary nodes only to boundary
@@ -93,8 +77,12 @@ Layout transfer_complex(const PolyMesh& quads, const QuadComplex& complex, const
 //! all edges), coarsens it (options.coarsen > 0), then builds the layout on the triangulated
 //! quad mesh (\p target == nullptr; exact, or routed like a transfer when coarsened) or on
 //! \p target (transfer_complex; when that fails and options.target_partition is given,
-//! layout_from_partition on it).
-//! \throw InvalidInputError as base_complex, triangulate_quads and transfer_complex.
+//! layout_from_partition on it). The triangulated quad mesh must pass the checks of the mesh
+//! reader (check_as_read: e.g. no triangle of zero area), so that it can be written and read
+//! back.
+//! \throw InvalidInputError as base_complex, triangulate_quads and transfer_complex; when the
+//!        triangulation fails the reader's checks, naming its problems and, for degenerate
+//!        triangles, the quads they lie in.
 QuadImportResult import_quads(const PolyMesh& quads, const TriMesh* target,
                               const QuadImportOptions& options = {});
 

@@ -15,14 +15,23 @@ bool ValidationResult::valid() const {
   return errors() == 0;
 }
 
+namespace {
+
+int count_issues(const std::vector<LayoutIssue>& issues, IssueSeverity severity) {
+  int count = 0;
+  for (const auto& i : issues)
+    if (i.severity == severity) count += i.omitted > 0 ? i.omitted : 1;
+  return count;
+}
+
+}  // namespace
+
 int ValidationResult::errors() const {
-  return static_cast<int>(std::count_if(issues.begin(), issues.end(), [](const LayoutIssue& i) {
-    return i.severity == IssueSeverity::Error;
-  }));
+  return count_issues(issues, IssueSeverity::Error);
 }
 
 int ValidationResult::warnings() const {
-  return static_cast<int>(issues.size()) - errors();
+  return count_issues(issues, IssueSeverity::Warning);
 }
 
 std::string format_issue(const LayoutIssue& issue) {
@@ -67,22 +76,35 @@ class Validator {
     const bool paths_ok = ids_ok && check_paths();
     check_features();
     if (paths_ok && check_disjoint()) check_topology();
+    for (const auto& [key, count] : omitted_) {
+      LayoutIssue summary;
+      summary.severity = key.first;
+      summary.code = key.second;
+      summary.message = "… and " + std::to_string(count) + " more of the same kind";
+      summary.omitted = count;
+      result_.issues.push_back(std::move(summary));
+    }
     return std::move(result_);
   }
 
  private:
-  void error(std::string code, std::string message, std::vector<int> nodes = {},
-             std::vector<int> arcs = {}, std::vector<int> vertices = {}) {
-    add(IssueSeverity::Error, std::move(code), std::move(message), std::move(nodes),
-        std::move(arcs), std::move(vertices));
+  // Each returns the listed issue, or nullptr when it is only counted (see omitted_).
+  LayoutIssue* error(std::string code, std::string message, std::vector<int> nodes = {},
+                     std::vector<int> arcs = {}, std::vector<int> vertices = {}) {
+    return add(IssueSeverity::Error, std::move(code), std::move(message), std::move(nodes),
+               std::move(arcs), std::move(vertices));
   }
-  void warning(std::string code, std::string message, std::vector<int> nodes = {},
-               std::vector<int> arcs = {}, std::vector<int> vertices = {}) {
-    add(IssueSeverity::Warning, std::move(code), std::move(message), std::move(nodes),
-        std::move(arcs), std::move(vertices));
+  LayoutIssue* warning(std::string code, std::string message, std::vector<int> nodes = {},
+                       std::vector<int> arcs = {}, std::vector<int> vertices = {}) {
+    return add(IssueSeverity::Warning, std::move(code), std::move(message), std::move(nodes),
+               std::move(arcs), std::move(vertices));
   }
-  void add(IssueSeverity s, std::string code, std::string message, std::vector<int> nodes,
-           std::vector<int> arcs, std::vector<int> vertices) {
+  LayoutIssue* add(IssueSeverity s, std::string code, std::string message, std::vector<int> nodes,
+                   std::vector<int> arcs, std::vector<int> vertices) {
+    if (listed_[{s, code}]++ >= kMaxListedIssuesPerCode) {
+      ++omitted_[{s, std::move(code)}];
+      return nullptr;
+    }
     LayoutIssue issue;
     issue.severity = s;
     issue.code = std::move(code);
@@ -91,6 +113,7 @@ class Validator {
     issue.arc_ids = std::move(arcs);
     issue.vertices = std::move(vertices);
     result_.issues.push_back(std::move(issue));
+    return &result_.issues.back();
   }
 
   int nv() const { return static_cast<int>(mesh_.n_vertices()); }
@@ -357,23 +380,21 @@ class Validator {
                                                  : " (arcs " + join(arc_ids) + ")");
       LayoutIssue* added = nullptr;
       if (P.border_cycles != 1 || P.euler != 1) {
-        error("patch_not_disk",
-              where + " is not a disk: " + std::to_string(P.border_cycles) +
-                  " border cycle(s), Euler characteristic " + std::to_string(P.euler),
-              node_ids, arc_ids, vertices);
-        added = &result_.issues.back();
+        added = error("patch_not_disk",
+                      where + " is not a disk: " + std::to_string(P.border_cycles) +
+                          " border cycle(s), Euler characteristic " + std::to_string(P.euler),
+                      node_ids, arc_ids, vertices);
       } else if (!P.trimmed && P.corners.size() != 4) {
-        error("patch_valence",
-              where + " has " + std::to_string(P.corners.size()) + " corners (nodes " +
-                  join(node_ids) + "); a full patch needs 4",
-              node_ids, arc_ids, vertices);
-        added = &result_.issues.back();
+        added = error("patch_valence",
+                      where + " has " + std::to_string(P.corners.size()) + " corners (nodes " +
+                          join(node_ids) + "); a full patch needs 4",
+                      node_ids, arc_ids, vertices);
       } else if (P.trimmed && P.corners.size() >= 4) {
-        error("patch_valence",
-              where + " is trimmed by the boundary and has " + std::to_string(P.corners.size()) +
-                  " corners (nodes " + join(node_ids) + "); a trimmed patch needs fewer than 4",
-              node_ids, arc_ids, vertices);
-        added = &result_.issues.back();
+        added = error("patch_valence",
+                      where + " is trimmed by the boundary and has " +
+                          std::to_string(P.corners.size()) + " corners (nodes " + join(node_ids) +
+                          "); a trimmed patch needs fewer than 4",
+                      node_ids, arc_ids, vertices);
       }
       if (added) added->patch_faces = {first_face[pid]};
     }
@@ -433,6 +454,8 @@ class Validator {
   const TriMesh& mesh_;
   const Layout& layout_;
   ValidationResult result_;
+  // Issues found per (severity, code), and those beyond kMaxListedIssuesPerCode (not listed).
+  std::map<std::pair<IssueSeverity, std::string>, int> listed_, omitted_;
 };
 
 }  // namespace

@@ -19,21 +19,33 @@ struct LayoutIssue {
   std::vector<int> arc_ids;
   std::vector<int> vertices;     //!< mesh vertices where the problem is (for highlighting)
   std::vector<int> patch_faces;  //!< a face of the offending patch, if any
+  //! > 0: this entry is the summary of that many further issues of the same code and severity
+  //! that are not listed (validate_layout lists kMaxListedIssuesPerCode per code); its id
+  //! lists are empty.
+  int omitted = 0;
 };
+
+//! validate_layout lists at most this many issues of each code, then one summary entry
+//! ("… and K more of the same kind", LayoutIssue::omitted = K), so that a layout with
+//! hundreds of thousands of problems is reported in bounded memory.
+inline constexpr int kMaxListedIssuesPerCode = 20;
 
 struct ValidationResult {
   std::vector<LayoutIssue> issues;
-  bool valid() const;  //!< no Error issue
-  int errors() const;
-  int warnings() const;
+  bool valid() const;    //!< no Error issue
+  int errors() const;    //!< Error issues, a summary entry counting as the issues it stands for
+  int warnings() const;  //!< the same for Warning issues
 };
 
 //! Checks a layout against a mesh (interfaces.md §1, algorithm.md §1.2): ids, paths,
 //! disjointness, dangling ends, patch disks, patch valences, Euler characteristic,
-//! connectivity, high-valence warnings. Never throws for bad layouts.
+//! connectivity, high-valence warnings. Lists at most kMaxListedIssuesPerCode issues per code
+//! (the first ones found), each further one counted in a summary entry at the end.
+//! Never throws for bad layouts.
 ValidationResult validate_layout(const TriMesh& mesh, const Layout& layout);
 
-//! One line per issue: "error [arc_crossing] arcs 3 and 7 share mesh edge (12, 13)".
+//! One line per issue: "error [arc_crossing] arcs 3 and 7 share mesh edge (12, 13)"; a summary
+//! entry: "error [arc_crossing] … and 12 more of the same kind".
 std::string format_issue(const LayoutIssue& issue);
 
 //! Validates a layout that this library produced (an import, a transfer) and throws
