@@ -168,7 +168,7 @@ bool accept_browser(AppContext& ctx) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) {  // a folder typed into the name field: go there
     browser.navigate(path);
-    browser.file_name.clear();
+    browser.set_file_name("");
     return false;
   }
   bool ok = false;

@@ -22,6 +22,7 @@ const std::set<std::string>& command_names() {
                                               "wait_step",
                                               "wait_finished",
                                               "wait_camera",
+                                              "wait_status",
                                               "run",
                                               "step",
                                               "pause",
@@ -51,6 +52,13 @@ const std::set<std::string>& command_names() {
                                               "state",
                                               "abort",
                                               "quit"};
+  return names;
+}
+
+// Commands whose argument is a path: the rest of the line.
+const std::set<std::string>& path_commands() {
+  static const std::set<std::string> names = {"open",  "save",         "screenshot",
+                                              "state", "browser_name", "browser_folder"};
   return names;
 }
 
@@ -92,7 +100,15 @@ bool Automation::load(std::string* error) {
     Command c;
     c.line = line;
     if (!(words >> c.name)) continue;
-    for (std::string w; words >> w;) c.args.push_back(w);
+    if (path_commands().count(c.name)) {  // the rest of the line is one path (spaces allowed)
+      std::string rest;
+      std::getline(words, rest);
+      const auto first = rest.find_first_not_of(" \t");
+      const auto last = rest.find_last_not_of(" \t\r");
+      if (first != std::string::npos) c.args.push_back(rest.substr(first, last - first + 1));
+    } else {
+      for (std::string w; words >> w;) c.args.push_back(w);
+    }
     if (!command_names().count(c.name)) {
       if (error)
         *error = options_.script_path + ":" + std::to_string(line) + ": unknown command '" +
@@ -122,8 +138,9 @@ bool Automation::wait(const Command& c, bool done, double default_timeout_s) {
     wait_start_ = now;
   }
   double timeout = default_timeout_s;
-  if (!c.args.empty() && c.name != "wait_step") parse_double(c.args[0], timeout);
-  if (c.name == "wait_step" && c.args.size() > 1) parse_double(c.args[1], timeout);
+  // The timeout follows the step (wait_step) or the status (wait_status).
+  const std::size_t at = c.name == "wait_step" || c.name == "wait_status" ? 1 : 0;
+  if (c.args.size() > at) parse_double(c.args[at], timeout);
   if (std::chrono::duration<double>(now - wait_start_).count() > timeout) {
     waiting_ = false;
     fail(c, "timed out after " + std::to_string(timeout) + " s");
@@ -134,7 +151,10 @@ bool Automation::wait(const Command& c, bool done, double default_timeout_s) {
 
 void Automation::before_frame(AppContext& ctx) {
   if (!options_.bench_orbit) return;
-  // A small trackball drag every frame: the worst case, the scene re-renders each frame.
+  // A small trackball drag every frame: the worst case, the scene re-renders each frame. The
+  // trackball (not the default turntable) keeps the views of earlier measurements.
+  if (ctx.camera.orbit_mode() != render::OrbitMode::Trackball)
+    ctx.camera.set_orbit_mode(render::OrbitMode::Trackball);
   const glm::vec2 centre = 0.5f * ctx.camera.viewport();
   ctx.camera.begin_orbit(centre);
   ctx.camera.orbit_to(centre + glm::vec2(3.0f, 1.0f));
@@ -173,6 +193,10 @@ bool Automation::run_command(const Command& c, AppContext& ctx, const glm::ivec2
                               latest->status == WorkerStatus::Failed));
   }
   if (n == "wait_camera") return wait(c, !ctx.camera.animating(), 30.0);
+  if (n == "wait_status") {
+    const SnapshotPtr& latest = editor.job.latest();
+    return wait(c, latest && !a.empty() && a[0] == to_string(latest->status));
+  }
   if (n == "run") {
     editor.run();
   } else if (n == "step") {
@@ -278,7 +302,7 @@ bool Automation::run_command(const Command& c, AppContext& ctx, const glm::ivec2
   } else if (n == "browser_folder") {
     if (a.empty() || !ctx.ui.browser.navigate(a[0])) fail(c, "not a folder");
   } else if (n == "browser_name") {
-    ctx.ui.browser.file_name = a.empty() ? std::string() : a[0];
+    ctx.ui.browser.set_file_name(a.empty() ? std::string() : a[0]);
   } else if (n == "browser_filter") {
     if (arg_int(0, x)) ctx.ui.browser.set_filter(x);
   } else if (n == "browser_accept") {

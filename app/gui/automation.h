@@ -2,12 +2,15 @@
 // --screenshot / --frames / --quit / --run / --stroke-vertices / --bench-* / --frame-profile
 // flags, the --state-json dump at exit, and --script files of editor commands.
 //
-// A script has one command per line ('#' starts a comment); one command runs per frame, after
-// the frame was drawn, through the same code as the mouse, keys and panels:
+// A script has one command per line ('#' starts a comment; a path argument is the rest of its
+// line); one command runs per frame, after the frame was drawn, through the same code as the
+// mouse, keys and panels:
 //   frames N                 wait N frames
 //   wait_step N [S]          until the shown result reached step N or the run ended (S: timeout
 //                            in seconds, default 300; a timeout fails the script)
 //   wait_finished [S]        until the run finished or failed
+//   wait_status NAME [S]     until the worker's status is NAME (idle, running, paused,
+//                            finished, failed, cancelled)
 //   wait_camera [S]          until the camera's animation ended
 //   run | step | pause | stop | keep | discard      the Pipeline panel's buttons
 //   set max_steps|descent_steps|node_optimization|publish_interval_ms V   a pipeline option

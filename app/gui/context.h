@@ -21,6 +21,7 @@ struct UiState {
   std::string mesh_field;    //!< Files panel: mesh path field
   std::string layout_field;  //!< Files panel: layout path field
   FileBrowser browser;
+  int browser_name_version = -1;  //!< FileBrowser::name_version() the name field shows
   //! The UI font has the glyphs beyond ASCII (DejaVu Sans); false: ImGui's default font, and
   //! text is shown in ASCII (ui_text()).
   bool unicode = true;

@@ -276,8 +276,23 @@ void Editor::on_layout_edited(const Layout& layout) {
 }
 
 void Editor::poll() {
-  job.poll(doc);
+  if (job.poll(doc)) {
+    // The end of a run replaces the "Running" message.
+    const Snapshot& s = *job.latest();
+    if (s.status != last_status_ && s.mesh == doc.mesh) {
+      if (s.status == WorkerStatus::Finished)
+        set_status("Run finished at step " + std::to_string(s.iteration) +
+                   ": Keep result adopts it, Discard drops it");
+      else if (s.status == WorkerStatus::Failed)
+        set_status("Run failed: " + s.message);
+    }
+    last_status_ = s.status;
+  }
   if (!doc.editor.dragging()) doc.refresh_validation();
+  // The selection may name what an undo or a new layout removed.
+  const Layout& layout = doc.editor.layout();
+  if (selection.node >= 0 && layout.node_index(selection.node) < 0) selection.node = -1;
+  if (selection.arc >= 0 && layout.arc_index(selection.arc) < 0) selection.arc = -1;
 }
 
 std::string Editor::run_blocker() {
@@ -412,14 +427,16 @@ void Editor::select(int node, int arc) {
 
 bool Editor::node_pinned(int id) const {
   if (job.live_pins()) return job.node_pinned(id);
-  const Layout& layout = doc.editor.layout();
+  const Snapshot* s = result();
+  const Layout& layout = s && s->layout ? *s->layout : doc.editor.layout();
   const int k = layout.node_index(id);
   return k >= 0 && layout.nodes[k].pinned;
 }
 
 bool Editor::arc_pinned(int id) const {
   if (job.live_pins()) return job.arc_pinned(id);
-  const Layout& layout = doc.editor.layout();
+  const Snapshot* s = result();
+  const Layout& layout = s && s->layout ? *s->layout : doc.editor.layout();
   const int k = layout.arc_index(id);
   return k >= 0 && layout.arcs[k].pinned;
 }

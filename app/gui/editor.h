@@ -117,7 +117,8 @@ class Editor {
   //! Highlights validation issue \p index and selects what it names; returns the mesh
   //! vertices to bring into view.
   std::vector<int> highlight_issue(int index);
-  //! Pinned state as drawn: the job's during a run, else the layout's.
+  //! Pinned state as drawn: the job's during a run (pins not yet applied included), the shown
+  //! result's, else the edited layout's.
   bool node_pinned(int id) const;
   bool arc_pinned(int id) const;
 
@@ -141,6 +142,7 @@ class Editor {
   std::string status_;
   std::string pending_note_;  //!< appended to the next status message
   std::vector<std::string> errors_;
+  WorkerStatus last_status_ = WorkerStatus::Idle;  //!< of the latest snapshot polled
   float mesh_diagonal_ = 1.0f;
   std::uint64_t mesh_diagonal_version_ = ~0ull;
 };

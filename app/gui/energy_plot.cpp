@@ -10,7 +10,7 @@
 
 namespace qs::app {
 
-void draw_energy_plot(const std::vector<double>& energy, int marked, float height) {
+void draw_energy_plot(const std::vector<double>& energy, int marked, float width_px, float height) {
   std::vector<std::pair<int, double>> points;  // (step, E)
   for (int k = 0; k < int(energy.size()); ++k)
     if (std::isfinite(energy[k]) && energy[k] > 0.0) points.push_back({k + 1, energy[k]});
@@ -29,7 +29,7 @@ void draw_energy_plot(const std::vector<double>& energy, int marked, float heigh
   float label_w = 0.0f;
   for (const auto& t : y_ticks) label_w = std::max(label_w, ImGui::CalcTextSize(t.label.c_str()).x);
   const ImVec2 origin = ImGui::GetCursorScreenPos();
-  const float width = std::max(80.0f, ImGui::GetContentRegionAvail().x);
+  const float width = std::max(80.0f, width_px);
   ImGui::InvisibleButton("##energy_plot", ImVec2(width, height));
   const bool hovered = ImGui::IsItemHovered();
   // Plot area: labels left of it and below it, half a line of room at the top.

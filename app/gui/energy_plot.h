@@ -7,8 +7,8 @@
 namespace qs::app {
 
 //! Draws the plot of \p energy (value k: step k + 1; non-finite or non-positive values are
-//! skipped) across the available width, \p height pixels tall; \p marked (index, -1: none) is
-//! marked with a vertical line (the scrubbed step).
-void draw_energy_plot(const std::vector<double>& energy, int marked, float height);
+//! skipped), \p width x \p height pixels; \p marked (index, -1: none) is marked with a vertical
+//! line (the scrubbed step).
+void draw_energy_plot(const std::vector<double>& energy, int marked, float width, float height);
 
 }  // namespace qs::app

@@ -51,7 +51,7 @@ std::string home_folder() {
 void FileBrowser::open(BrowserMode mode, const std::string& start) {
   mode_ = mode;
   filter_ = 0;
-  file_name.clear();
+  set_file_name("");
   confirm_replace.clear();
   error_.clear();
   open_ = true;
@@ -63,7 +63,7 @@ void FileBrowser::open(BrowserMode mode, const std::string& start) {
       folder = p;
     } else {
       folder = p.parent_path();
-      if (mode == BrowserMode::Save) file_name = p.filename().string();
+      if (mode == BrowserMode::Save) set_file_name(p.filename().string());
     }
   }
   if (folder.empty() || !fs::is_directory(folder, ec)) folder = home_folder();
@@ -135,11 +135,16 @@ void FileBrowser::refresh() {
   if (!folder_.empty()) navigate(folder_);
 }
 
+void FileBrowser::set_file_name(const std::string& name) {
+  file_name = name;
+  ++name_version_;
+}
+
 void FileBrowser::select(const BrowserEntry& entry) {
   if (entry.directory)
     navigate((fs::path(folder_) / entry.name).string());
   else
-    file_name = entry.name;
+    set_file_name(entry.name);
 }
 
 std::string FileBrowser::chosen_path() const {

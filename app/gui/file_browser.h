@@ -52,8 +52,12 @@ class FileBrowser {
   const std::string& error() const { return error_; }
   bool show_hidden = false;
 
-  //! The file name field.
+  //! The file name field (typed into by the UI).
   std::string file_name;
+  //! Sets the file name from outside the field (a click on a file, a script); bumps
+  //! name_version so that the UI's field shows it even while it has the keyboard.
+  void set_file_name(const std::string& name);
+  int name_version() const { return name_version_; }
   //! The folder field (set to folder() by every navigation; typed paths go to navigate()).
   std::string folder_field;
   //! Save mode: the existing file the user is asked to confirm replacing ("" when none).
@@ -73,6 +77,7 @@ class FileBrowser {
   std::string folder_;
   std::vector<BrowserEntry> entries_;
   std::string error_;
+  int name_version_ = 0;
 };
 
 //! The user's home folder ($HOME), or the working directory.

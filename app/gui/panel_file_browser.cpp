@@ -61,7 +61,7 @@ void places(AppContext& ctx) {
       ImGui::PushID(f.c_str());
       if (ImGui::Selectable(file_name(f).c_str())) {
         browser.navigate(fs::path(f).parent_path().string());
-        browser.file_name = fs::path(f).filename().string();
+        browser.set_file_name(fs::path(f).filename().string());
       }
       tooltip(f);
       ImGui::PopID();
@@ -85,6 +85,7 @@ void draw_file_browser(AppContext& ctx) {
                            ImGuiCond_Appearing);
   const bool save = browser.mode() == BrowserMode::Save;
   bool open = true;
+  ImGui::SetNextWindowBgAlpha(1.0f);  // opaque: the listing reads better than the scene
   ImGui::Begin(save ? "Save layout as###browser" : "Open mesh or layout###browser", &open,
                ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings);
 
@@ -135,10 +136,15 @@ void draw_file_browser(AppContext& ctx) {
 
   // File name, OK / Cancel.
   ImGui::SetNextItemWidth(-12.0f * em);
-  if (ImGui::IsWindowAppearing()) ImGui::SetKeyboardFocusHere();
+  // A name set from outside (a click on a file) gets a fresh field, which keeps the keyboard.
+  if (ImGui::IsWindowAppearing() || ctx.ui.browser_name_version != browser.name_version())
+    ImGui::SetKeyboardFocusHere();
+  ctx.ui.browser_name_version = browser.name_version();
+  ImGui::PushID(browser.name_version());
   const bool enter =
       ImGui::InputTextWithHint("##name", save ? "file name (.layout.json)" : "file name",
                                &browser.file_name, ImGuiInputTextFlags_EnterReturnsTrue);
+  ImGui::PopID();
   tooltip("A name in this folder or a full path; Enter " + std::string(save ? "saves" : "opens"));
   ImGui::SameLine();
   if (ImGui::Button(save ? "Save" : "Open", ImVec2(5.5f * em, 0)) || enter) accept(ctx);
@@ -152,6 +158,10 @@ void draw_file_browser(AppContext& ctx) {
   } else {
     ImGui::TextDisabled("%s", browser.chosen_path().c_str());
   }
+  // Esc closes it (while the window has the keyboard).
+  if (ImGui::IsWindowFocused(ImGuiFocusedFlags_RootAndChildWindows) &&
+      ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape)))
+    open = false;
   ImGui::End();
   if (!open) browser.close();
 }

@@ -1,8 +1,9 @@
-// Metrics: the quality of the shown result and the time of its last step, each with a
-// tooltip saying what it measures and which values are good.
+// Metrics: the convergence plot, the quality of the shown result and the time of its last
+// step, each with a tooltip saying what it measures and which values are good.
 #include <cmath>
 #include <cstdio>
 
+#include "app/gui/energy_plot.h"
 #include "app/gui/panels.h"
 #include "app/gui/ui_text.h"
 
@@ -35,10 +36,14 @@ void draw_metrics_panel(AppContext& ctx) {
   const Snapshot& s = *shown;
   const StepMetrics& m = s.metrics;
   const ImGuiIO& io = ImGui::GetIO();
-  const float width = 15.0f * ImGui::GetFontSize();
+  // Along the right edge; as wide as the plot (its widest item).
+  const float plot_width = 15.0f * ImGui::GetFontSize();
+  const float width = plot_width + 2.0f * ImGui::GetStyle().WindowPadding.x;
   ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - width - 10.0f, 10.0f), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(width, 0.0f), ImGuiCond_FirstUseEver);
   ImGui::Begin("Metrics", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+  const JobControl& job = ctx.editor.job;
+  draw_energy_plot(s.energy_history, job.history_live ? -1 : job.history_step, plot_width,
+                   7.0f * ImGui::GetFontSize());
   const ImGuiTableFlags flags = ImGuiTableFlags_SizingStretchProp | ImGuiTableFlags_RowBg;
   if (ImGui::BeginTable("quality", 2, flags)) {
     metric_row("E_init", s.energy_init, "%.6g",

@@ -1,9 +1,8 @@
 // Pipeline: Run / Pause / Step / Stop, why Run cannot start, the run's state, Keep result /
-// Discard, the convergence plot and the step history.
+// Discard and the step history (the convergence plot is in the Metrics window).
 #include <algorithm>
 #include <cmath>
 
-#include "app/gui/energy_plot.h"
 #include "app/gui/panels.h"
 
 namespace qs::app {
@@ -100,8 +99,6 @@ void draw_pipeline_panel(AppContext& ctx) {
     if (ImGui::Button("Discard")) editor.discard_result();
     tooltip("Drop this result and show the layout you edit");
   }
-  draw_energy_plot(s->energy_history, job.history_live ? -1 : job.history_step,
-                   7.0f * ImGui::GetFontSize());
   draw_history(ctx, *s);
 }
 

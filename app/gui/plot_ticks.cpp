@@ -54,18 +54,15 @@ std::vector<AxisTick> log_ticks(double lo, double hi) {
   const double decades = std::log10(hi / lo);
   const double eps = 1e-9;
   if (decades >= 1.0) {
-    const int d0 = int(std::ceil(std::log10(lo) - eps));
+    const int d0 = int(std::floor(std::log10(lo) + eps));
     const int d1 = int(std::floor(std::log10(hi) + eps));
     const int every = std::max(1, int(std::ceil((d1 - d0 + 1) / 6.0)));  // at most ~6 labels
-    for (int d = d0; d <= d1; d += every) {
-      const double p = std::pow(10.0, d);
-      ticks.push_back({p, tick_label(p)});
-      if (decades < 3.0)
-        for (double m : {2.0, 5.0})
-          if (m * p <= hi * (1 + eps)) ticks.push_back({m * p, tick_label(m * p)});
-    }
-    std::sort(ticks.begin(), ticks.end(),
-              [](const AxisTick& a, const AxisTick& b) { return a.value < b.value; });
+    for (int d = d0; d <= d1; d += every)
+      for (double m : {1.0, 2.0, 5.0}) {
+        if (m > 1.0 && decades >= 3.0) break;
+        const double v = m * std::pow(10.0, d);
+        if (v >= lo * (1 - eps) && v <= hi * (1 + eps)) ticks.push_back({v, tick_label(v)});
+      }
   } else if (hi > lo) {
     // Less than a decade: evenly spaced values read better than a single power of ten.
     const double step = nice_step((hi - lo) / 3.0);

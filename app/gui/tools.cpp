@@ -49,6 +49,13 @@ glm::vec3 vertex_position(const TriMesh& mesh, int v) {
   return {float(p[0]), float(p[1]), float(p[2])};
 }
 
+// The layout on screen: the shown result's (nodes where the run moved them), else the edited
+// one. Both have the same node and arc ids.
+const Layout& shown_layout(const Editor& editor) {
+  const Snapshot* s = editor.result();
+  return s && s->layout ? *s->layout : editor.doc.editor.layout();
+}
+
 std::optional<render::SurfaceHit> pick_surface(const glm::vec2& at, const Editor& editor,
                                                const render::Camera& camera,
                                                const render::SurfacePicker& picker) {
@@ -85,7 +92,7 @@ int Tools::pick_node(const glm::vec2& at, float radius_px, const Editor& editor,
   const float slack = 0.02f * camera.scene_radius();
   int best = -1;
   float best_d = radius_px;
-  for (const auto& node : editor.doc.editor.layout().nodes) {
+  for (const auto& node : shown_layout(editor).nodes) {
     if (node.vertex < 0 || node.vertex >= int(mesh->n_vertices())) continue;
     const glm::vec3 p = vertex_position(*mesh, node.vertex);
     const glm::vec3 s = camera.project(p);
@@ -108,7 +115,7 @@ int Tools::pick_arc(const glm::vec2& at, float radius_px, const Editor& editor,
   const float slack = 0.02f * camera.scene_radius();
   int best = -1;
   float best_d = radius_px;
-  for (const auto& arc : editor.doc.editor.layout().arcs) {
+  for (const auto& arc : shown_layout(editor).arcs) {
     glm::vec3 prev_world{0.0f};
     glm::vec2 prev{0.0f};
     bool have_prev = false;

@@ -69,7 +69,8 @@ class Tools {
   //! True while a drag of the mouse is in progress (camera or tool).
   bool dragging() const { return drag_ != Drag::None && drag_ != Drag::Pending; }
 
-  // Picking (window pixels; hidden nodes and arcs behind the surface are not picked).
+  // Picking in the layout on screen (the shown result's, else the edited one), window
+  // pixels; nodes and arcs hidden behind the surface are not picked.
   int pick_node(const glm::vec2& at, float radius_px, const Editor& editor,
                 const render::Camera& camera, const render::SurfacePicker& picker) const;
   int pick_arc(const glm::vec2& at, float radius_px, const Editor& editor,
