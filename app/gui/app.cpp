@@ -136,9 +136,12 @@ bool App::frame(const glm::ivec2& framebuffer, float dt) {
     picker_mesh_version_ = editor_.doc.mesh_version;
   }
   if (editor_.doc.mesh && camera_mesh_version_ != editor_.doc.mesh_version) {
-    // A new mesh: its bounds, and the home view (at once for the first one).
+    // A new mesh (however it was opened): its bounds, the home view (at once for the first
+    // one), and its paths in the Files panel.
     fit_camera_to_mesh(ctx, true, camera_mesh_version_ == ~0ull);
     camera_mesh_version_ = editor_.doc.mesh_version;
+    ui_.mesh_field = editor_.doc.mesh_path;
+    ui_.layout_field = editor_.doc.layout_path;
   }
   int win_w = 0, win_h = 0;
   glfwGetWindowSize(window_, &win_w, &win_h);
@@ -169,8 +172,6 @@ int App::run() {
   }
   const bool loaded = editor_.start(options_.mesh_path, options_.layout_path);
   if (!loaded && automation_.quit_on_load_error()) return 2;  // the reasons are printed
-  ui_.mesh_field = editor_.doc.mesh_path;
-  ui_.layout_field = editor_.doc.layout_path;
   if (!init_window()) {
     std::fprintf(stderr, "quadsketch: cannot create an OpenGL 3.3 window (is DISPLAY set?)\n");
     return 1;

@@ -297,8 +297,7 @@ void Editor::poll() {
 
 std::string Editor::run_blocker() {
   if (!doc.mesh) return "no mesh is open (Ctrl+O opens one)";
-  if (doc.editor.dragging()) return "a node is being dragged";
-  doc.refresh_validation();
+  if (!doc.editor.dragging()) doc.refresh_validation();  // while dragging: the last one
   const Layout& layout = doc.editor.layout();
   if (layout.nodes.empty()) return "the layout is empty: place nodes (tool 2) and draw arcs (3)";
   if (layout.arcs.empty()) return "the layout has no arcs: draw arcs between the nodes (tool 3)";

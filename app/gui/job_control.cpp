@@ -106,8 +106,8 @@ void JobControl::send_options() {
 
 void JobControl::start_fresh(const Document& doc) {
   // A new run starts from the edited layout (not from an earlier run's state), without the
-  // pins toggled during that run; a stopped result it replaces is gone.
-  if (held_.kind == ResultKind::Stopped) held_ = {};
+  // pins toggled during that run, and replaces the result shown (stopped or kept).
+  held_ = {};
   stop_seq_ = 0;
   worker_->send(cmd::SetLayout{doc.editor.layout()});
   send_options();

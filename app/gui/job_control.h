@@ -20,7 +20,8 @@ enum class ResultKind {
   None,     //!< no result: the edited layout is shown
   Live,     //!< the worker's current job (running, paused, finished; not failed)
   Stopped,  //!< a run ended with Stop: its state when stopped (Keep or Discard it)
-  Kept,     //!< adopted with Keep result; shown while the edited layout is unchanged
+  Kept,     //!< adopted with Keep result; shown while the edited layout is unchanged and
+            //!< until the next run
 };
 
 const char* to_string(ResultKind kind);
@@ -44,7 +45,8 @@ class JobControl {
   //! The edited layout changed (an edit, undo, redo): the worker takes it, cancelling a run.
   //! Returns true when this dropped a shown result that was not kept.
   bool layout_edited(const Layout& layout);
-  //! Resumes a paused run, or starts a new one from the edited layout.
+  //! Resumes a paused run, or starts a new one from the edited layout (which replaces the
+  //! stopped or kept result shown).
   void run(const Document& doc);
   //! One step: of the paused run, or the first of a new run from the edited layout.
   void step(const Document& doc);

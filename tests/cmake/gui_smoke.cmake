@@ -1,5 +1,6 @@
-# GUI tests: the layout editor unit (GL-free app code) and smoke tests of the quadsketch
-# executable (screenshot under Xvfb, exit codes). Included by tests/CMakeLists.txt.
+# GUI tests: the layout editor unit and the editor's state (GL-free app code), the editor end to
+# end under Xvfb (gui_app_test, driven by --script), and smoke tests of the quadsketch
+# executable (screenshots, exit codes). Included by tests/CMakeLists.txt.
 
 # layout_editor_test.cpp is picked up by the *_test.cpp glob, which links qs_core only: add
 # the app sources it exercises (all GL-free).
