@@ -32,17 +32,20 @@ void draw_camera(AppContext& ctx) {
     render::AxisView view;
     const char* tip;
   };
+  // The numpad's views and, below them, their opposites (Ctrl).
   const ViewButton views[] = {
       {"Front", render::AxisView::Front, "Look along -z (numpad 1)"},
-      {"Back", render::AxisView::Back, "Look along +z (Ctrl+numpad 1)"},
       {"Right", render::AxisView::Right, "Look along -x (numpad 3)"},
-      {"Left", render::AxisView::Left, "Look along +x (Ctrl+numpad 3)"},
       {"Top", render::AxisView::Top, "Look down -y (numpad 7)"},
+      {"Back", render::AxisView::Back, "Look along +z (Ctrl+numpad 1)"},
+      {"Left", render::AxisView::Left, "Look along +x (Ctrl+numpad 3)"},
       {"Bottom", render::AxisView::Bottom, "Look up +y (Ctrl+numpad 7)"},
   };
+  const float column = 4.5f * ImGui::GetFontSize();
   for (int i = 0; i < 6; ++i) {
-    if (i > 0) ImGui::SameLine();
-    if (ImGui::SmallButton(views[i].label)) camera.set_axis_view(views[i].view);
+    if (i % 3 != 0) ImGui::SameLine(float(i % 3) * column + ImGui::GetStyle().WindowPadding.x);
+    if (ImGui::Button(views[i].label, ImVec2(column - 6.0f, 0.0f)))
+      camera.set_axis_view(views[i].view);
     tooltip(views[i].tip);
   }
   if (ImGui::Button("Frame all")) camera.frame_all();
