@@ -41,6 +41,8 @@ struct SceneData {
   std::vector<int> preview_path;
   //! Optimistic pin state (node id, pinned) for pins sent to the worker but not yet applied.
   std::vector<std::pair<int, bool>> pin_overrides;
+  //! The same for arcs: (arc id, pinned).
+  std::vector<std::pair<int, bool>> arc_pin_overrides;
   std::uint64_t interaction_version = 0;
   //! Node positions per streamed step (null: no trajectories) and the step shown (index into
   //! it, -1: none).

@@ -135,7 +135,10 @@ void LayoutLayer::upload(const SceneData& data) {
     std::vector<glm::vec3> poly;
     for (int pass = 0; pass < 2; ++pass) {
       for (const auto& arc : layout.arcs) {
-        if (pass == 0 && !arc.pinned && arc.id != data.selected_arc) continue;
+        bool pinned = arc.pinned;
+        for (const auto& [id, state] : data.arc_pin_overrides)
+          if (id == arc.id) pinned = state;
+        if (pass == 0 && !pinned && arc.id != data.selected_arc) continue;
         poly.clear();
         if (!arc.polyline.empty()) {
           for (const auto& p : arc.polyline) poly.emplace_back(p[0], p[1], p[2]);

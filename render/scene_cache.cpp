@@ -34,6 +34,11 @@ void add_scene(FrameKey& key, const SceneData& scene) {
     key.add(node);
     key.add(pinned);
   }
+  key.add(scene.arc_pin_overrides.size());
+  for (const auto& [arc, pinned] : scene.arc_pin_overrides) {
+    key.add(arc);
+    key.add(pinned);
+  }
   key.add(scene.interaction_version);
   key.add(reinterpret_cast<std::uintptr_t>(scene.node_history));
   key.add(scene.history_step);

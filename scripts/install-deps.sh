@@ -11,6 +11,7 @@ PACKAGES=(
   nlohmann-json3-dev libcli11-dev libgtest-dev libbenchmark-dev
   coinor-libipopt-dev
   libgl-dev libegl-dev libopengl-dev libgl1-mesa-dri libegl-mesa0 mesa-utils
+  fonts-dejavu-core
   xvfb xauth
   assimp-utils
   clang libclang-rt-14-dev

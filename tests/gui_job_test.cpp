@@ -371,4 +371,87 @@ TEST(GuiJob, NodePinnedMidRunStaysPut) {
   EXPECT_EQ(s->exports->mesh.point(s->exports->mesh.vertex_handle(vertex)), position);
 }
 
+// An arc pinned between steps (SetArcPin) keeps its route and its end nodes for the rest of the
+// run, and the run goes on (the job is not restarted: its step count and history continue).
+TEST(GuiJob, ArcPinnedMidRunKeepsTheJobAndStaysPut) {
+  using namespace std::chrono_literals;
+  const Example ex = example();
+  WorkerOptions options;
+  options.publish_interval_ms = 0;
+  Worker worker(pipeline_step);
+  worker.send(cmd::SetOptions{options});
+  worker.send(cmd::LoadMesh{ex.mesh, ex.layout});
+  worker.send(cmd::Step{3});
+  auto s = worker.wait_for(
+      [](const Snapshot& x) { return x.iteration >= 3 && x.status != WorkerStatus::Running; }, 60s);
+  ASSERT_EQ(s->iteration, 3) << s->message;
+  const std::uint64_t generation = s->generation;
+  const LayoutArc arc = s->layout->arcs[0];
+  const std::vector<int> ends{arc.from, arc.to};
+  const auto frame_positions = [&](const NodeFrame& f) {
+    std::vector<std::array<float, 3>> out;
+    for (int id : ends)
+      for (size_t k = 0; k < f.ids.size(); ++k)
+        if (f.ids[k] == id) out.push_back(f.positions[k]);
+    return out;
+  };
+  const auto pinned_at = frame_positions(*s->node_history.back());
+  ASSERT_EQ(pinned_at.size(), 2u);
+  const auto pin_seq = worker.send(cmd::SetArcPin{arc.id, true});
+  worker.send(cmd::Run{});
+  s = worker.wait_for(
+      [](const Snapshot& x) {
+        return x.status == WorkerStatus::Finished || x.status == WorkerStatus::Failed;
+      },
+      120s);
+  ASSERT_EQ(s->status, WorkerStatus::Finished) << s->message;
+  EXPECT_GE(s->applied_seq, pin_seq);
+  EXPECT_EQ(s->generation, generation);  // the same job
+  ASSERT_GT(s->iteration, 5);
+  ASSERT_EQ(s->node_history.size(), std::size_t(s->iteration));
+  for (size_t k = 3; k < s->node_history.size(); ++k)
+    EXPECT_EQ(frame_positions(*s->node_history[k]), pinned_at) << "frame " << k;
+  const int a = s->layout->arc_index(arc.id);
+  ASSERT_GE(a, 0);
+  EXPECT_TRUE(s->layout->arcs[a].pinned);
+  EXPECT_EQ(s->layout->arcs[a].path, arc.path);
+}
+
+// A node that the editor's layout pins and that is released during the run (ClearPin) moves
+// from then on.
+TEST(GuiJob, LayoutPinReleasedMidRunLetsTheNodeMove) {
+  using namespace std::chrono_literals;
+  Example ex = example();
+  ex.layout.nodes[0].pinned = true;
+  const int id = ex.layout.nodes[0].id;
+  WorkerOptions options;
+  options.publish_interval_ms = 0;
+  Worker worker(pipeline_step);
+  worker.send(cmd::SetOptions{options});
+  worker.send(cmd::LoadMesh{ex.mesh, ex.layout});
+  worker.send(cmd::Step{3});
+  auto s = worker.wait_for(
+      [](const Snapshot& x) { return x.iteration >= 3 && x.status != WorkerStatus::Running; }, 60s);
+  ASSERT_EQ(s->iteration, 3) << s->message;
+  const auto position = [&](const NodeFrame& f) {
+    for (size_t k = 0; k < f.ids.size(); ++k)
+      if (f.ids[k] == id) return f.positions[k];
+    return std::array<float, 3>{};
+  };
+  const auto before = position(*s->node_history.front());
+  EXPECT_EQ(position(*s->node_history.back()), before);  // pinned so far
+  worker.send(cmd::ClearPin{id});
+  worker.send(cmd::Run{});
+  s = worker.wait_for(
+      [](const Snapshot& x) {
+        return x.status == WorkerStatus::Finished || x.status == WorkerStatus::Failed;
+      },
+      120s);
+  ASSERT_EQ(s->status, WorkerStatus::Finished) << s->message;
+  EXPECT_NE(position(*s->node_history.back()), before);
+  const int n = s->layout->node_index(id);
+  ASSERT_GE(n, 0);
+  EXPECT_FALSE(s->layout->nodes[n].pinned);
+}
+
 }  // namespace qs::app

@@ -3,7 +3,8 @@
 //   gui_smoke_check screenshot --app A --mesh M --layout L --out PNG [--width W --height H]
 //                   [--expect-colors "r,g,b,min;..."] [-- app arguments...]
 //     Runs `xvfb-run ... A --mesh M --layout L --screenshot PNG --frames 5 --quit` (no --frames
-//     when the extra arguments contain --run) and checks the picture: expected size, the centre
+//     when the extra arguments contain --run; a fresh autosave folder PNG.autosave, so that no
+//     autosave is offered over the scene) and checks the picture: expected size, the centre
 //     differs from the background, it has edges (wireframe, arcs), and each expected colour
 //     covers enough pixels. Exits 77 (CTest skip) when xvfb-run is not installed.
 //   gui_smoke_check exit-code --app A --expect N [app arguments...]
@@ -75,10 +76,15 @@ int check_screenshot(const std::map<std::string, std::string>& args,
       return 1;
     }
   std::filesystem::remove(png);
-  std::string command = "xvfb-run -a -s '-screen 0 " + std::to_string(want_w) + "x" +
-                        std::to_string(want_h) + "x24' " + quote(args.at("--app")) + " --mesh " +
-                        quote(args.at("--mesh")) + " --layout " + quote(args.at("--layout")) +
-                        " --screenshot " + quote(png) + " --quit";
+  // A fresh autosave folder: an autosave left by another test would be offered in a window
+  // over the scene.
+  const std::string autosave = png + ".autosave";
+  std::filesystem::remove_all(autosave);
+  std::string command = "env QS_AUTOSAVE_DIR=" + quote(autosave) + " xvfb-run -a -s '-screen 0 " +
+                        std::to_string(want_w) + "x" + std::to_string(want_h) + "x24' " +
+                        quote(args.at("--app")) + " --mesh " + quote(args.at("--mesh")) +
+                        " --layout " + quote(args.at("--layout")) + " --screenshot " + quote(png) +
+                        " --quit";
   // Extra app arguments after "--"; a run takes its screenshot when it finishes.
   bool runs = false;
   for (const auto& a : rest) {

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -494,10 +495,13 @@ TEST_F(LayoutEditorTest, AutosaveIsValidJsonAfterAnEdit) {
   EXPECT_EQ(back.arcs.size(), 4u);
   EXPECT_EQ(back.arcs[2].path, editor_.layout().arcs[2].path);
 
-  const auto offer = find_autosave(mesh_file.string(), "");
+  const auto offer = find_autosave(mesh_file.string());
   ASSERT_TRUE(offer.has_value());
   EXPECT_EQ(offer->path, autosave_path());
-  EXPECT_FALSE(find_autosave((dir / "other.obj").string(), "").has_value());
+  EXPECT_EQ(offer->mesh_path, fs::weakly_canonical(mesh_file).string());
+  EXPECT_FALSE(offer->saved_at.empty());
+  EXPECT_FALSE(find_autosave((dir / "other.obj").string()).has_value());
+  EXPECT_TRUE(find_autosave().has_value());  // whatever mesh is open
   // One file carries the layout and its description (a single atomic write), no sidecar.
   EXPECT_EQ(json.at("autosave").at("mesh"), fs::weakly_canonical(mesh_file).string());
   std::size_t files = 0;
@@ -505,7 +509,40 @@ TEST_F(LayoutEditorTest, AutosaveIsValidJsonAfterAnEdit) {
   EXPECT_EQ(files, 2u);  // grid.obj and autosave.layout.json
   // A torn or foreign file is never offered.
   std::ofstream(autosave_path()) << "{ \"format\": \"quadsketch-layout\", \"nod";
-  EXPECT_FALSE(find_autosave(mesh_file.string(), "").has_value());
+  EXPECT_FALSE(find_autosave(mesh_file.string()).has_value());
+  EXPECT_FALSE(find_autosave().has_value());
+  fs::remove_all(dir);
+}
+
+// An autosave made while editing a layout file is not offered once that file was saved after
+// it; set aside, it is no longer the autosave; removed, nothing is offered.
+TEST_F(LayoutEditorTest, AutosaveOfferFollowsSavesAndCanBeSetAside) {
+  const fs::path dir = fresh_dir("autosave_saved");
+  ScopedEnv env("QS_AUTOSAVE_DIR", dir.string());
+  const fs::path mesh_file = dir / "grid.obj";
+  const fs::path layout_file = dir / "grid.layout.json";
+  std::ofstream(mesh_file) << "# placeholder name only\n";
+  std::ofstream(layout_file) << "{}";
+  fs::last_write_time(layout_file, fs::file_time_type::clock::now() - std::chrono::hours(1));
+  sketch_square();
+  write_autosave(editor_.layout(), &mesh_, mesh_file.string(), layout_file.string());
+  const auto offer = find_autosave();
+  ASSERT_TRUE(offer.has_value());
+  EXPECT_EQ(offer->layout_path, fs::weakly_canonical(layout_file).string());
+  fs::last_write_time(layout_file, fs::file_time_type::clock::now() + std::chrono::hours(1));
+  EXPECT_FALSE(find_autosave().has_value());  // saved after the autosave
+
+  fs::last_write_time(layout_file, fs::file_time_type::clock::now() - std::chrono::hours(1));
+  ASSERT_TRUE(find_autosave().has_value());
+  const std::string aside = set_autosave_aside();
+  EXPECT_EQ(aside, (dir / "autosave.previous.layout.json").string());
+  EXPECT_TRUE(fs::exists(aside));
+  EXPECT_FALSE(find_autosave().has_value());
+  write_autosave(editor_.layout(), &mesh_, mesh_file.string(), "");
+  ASSERT_TRUE(find_autosave().has_value());
+  remove_autosave();
+  EXPECT_FALSE(find_autosave().has_value());
+  EXPECT_EQ(set_autosave_aside(), "");
   fs::remove_all(dir);
 }
 

@@ -7,6 +7,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <map>
+#include <mutex>
+#include <set>
 #include <thread>
 
 #include "app/gui/history.h"
@@ -184,6 +187,46 @@ TEST(Worker, RepeatedSetPinForOneNodeCollapses) {
   ASSERT_EQ(s->pins.size(), 2u);
   EXPECT_EQ(s->pins[0][0], 1);
   EXPECT_EQ(s->pins[0][1], 3);  // the latest wins
+}
+
+TEST(Worker, ArcPinsAndReleasesAreAppliedAtTheNextStepAndSetLayoutDropsThem) {
+  std::mutex seen_mutex;
+  std::map<int, bool> seen_arcs;
+  std::set<int> seen_released;
+  Worker worker([&](WorkerState& state, const WorkerObserver&) {
+    std::lock_guard lock(seen_mutex);
+    seen_arcs = state.arc_pins;
+    seen_released = state.released;
+    StepResult r;
+    r.validate = false;
+    return r;
+  });
+  worker.send(cmd::LoadMesh{tetrahedron(), Layout{}});
+  worker.send(cmd::SetPin{4, 1});
+  const auto release_seq = worker.send(cmd::ClearPin{4});  // released: also a layout pin
+  worker.send(cmd::SetArcPin{3, false});
+  const auto arc_seq = worker.send(cmd::SetArcPin{3, true});  // replaces the queued one
+  worker.send(cmd::Step{});
+  auto s = worker.wait_for([&](const Snapshot& x) { return x.iteration >= 1; }, 5s);
+  ASSERT_EQ(s->iteration, 1);
+  EXPECT_GE(s->applied_seq, std::max(release_seq, arc_seq));
+  EXPECT_TRUE(s->pins.empty());
+  {
+    std::lock_guard lock(seen_mutex);
+    EXPECT_EQ(seen_arcs, (std::map<int, bool>{{3, true}}));
+    EXPECT_EQ(seen_released, (std::set<int>{4}));
+  }
+  // A new layout carries its own pins: the commands' pins are gone at the next step.
+  worker.send(cmd::SetPin{5, 2});
+  worker.send(cmd::SetLayout{Layout{}});
+  const auto step_seq = worker.send(cmd::Step{});
+  s = worker.wait_for(
+      [&](const Snapshot& x) { return x.applied_seq >= step_seq && x.iteration >= 1; }, 5s);
+  ASSERT_GE(s->applied_seq, step_seq);
+  EXPECT_TRUE(s->pins.empty());
+  std::lock_guard lock(seen_mutex);
+  EXPECT_TRUE(seen_arcs.empty());
+  EXPECT_TRUE(seen_released.empty());
 }
 
 TEST(Worker, FailuresArePublishedAndTheWorkerStaysAlive) {

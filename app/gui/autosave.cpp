@@ -56,8 +56,7 @@ void write_autosave(const Layout& layout, const TriMesh* mesh, const std::string
   write_file_atomic(autosave_path().string(), text);
 }
 
-std::optional<AutosaveOffer> find_autosave(const std::string& mesh_path,
-                                           const std::string& layout_path) {
+std::optional<AutosaveOffer> find_autosave() {
   try {
     std::error_code ec;
     const fs::path autosave = autosave_path();
@@ -65,20 +64,38 @@ std::optional<AutosaveOffer> find_autosave(const std::string& mesh_path,
     const auto document = nlohmann::json::parse(read_file(autosave.string()));
     if (!document.is_object() || !document.contains("autosave")) return std::nullopt;
     const auto& meta = document.at("autosave");
-    if (meta.value("mesh", std::string()) != absolute_string(mesh_path)) return std::nullopt;
     AutosaveOffer offer;
     offer.path = autosave;
+    offer.mesh_path = meta.value("mesh", std::string());
     offer.layout_path = meta.value("layout", std::string());
     offer.saved_at = meta.value("saved_at", std::string());
-    if (!layout_path.empty() && fs::exists(layout_path, ec)) {
-      if (offer.layout_path != absolute_string(layout_path)) return std::nullopt;
-      if (fs::last_write_time(autosave, ec) <= fs::last_write_time(layout_path, ec))
-        return std::nullopt;
-    }
+    if (!offer.layout_path.empty() && fs::exists(offer.layout_path, ec) &&
+        fs::last_write_time(autosave, ec) <= fs::last_write_time(offer.layout_path, ec))
+      return std::nullopt;  // saved after the last autosave
     return offer;
   } catch (const std::exception&) {
-    return std::nullopt;  // a corrupt sidecar is not worth an error at start-up
+    return std::nullopt;  // a corrupt autosave is not worth an error at start-up
   }
+}
+
+std::optional<AutosaveOffer> find_autosave(const std::string& mesh_path) {
+  auto offer = find_autosave();
+  if (offer && offer->mesh_path != absolute_string(mesh_path)) return std::nullopt;
+  return offer;
+}
+
+void remove_autosave() {
+  std::error_code ec;
+  fs::remove(autosave_path(), ec);
+}
+
+std::string set_autosave_aside() {
+  std::error_code ec;
+  const fs::path from = autosave_path();
+  if (!fs::exists(from, ec)) return {};
+  const fs::path to = autosave_dir() / "autosave.previous.layout.json";
+  fs::rename(from, to, ec);
+  return ec ? std::string() : to.string();
 }
 
 }  // namespace qs::app

@@ -25,13 +25,23 @@ void write_autosave(const Layout& layout, const TriMesh* mesh, const std::string
 
 struct AutosaveOffer {
   std::filesystem::path path;  //!< the autosave layout
+  std::string mesh_path;       //!< the mesh it belongs to (absolute)
   std::string layout_path;     //!< the file it was editing ("" for a new layout)
   std::string saved_at;        //!< local time, for the prompt
 };
 
-//! An autosave worth offering for \p mesh_path: made for the same mesh file and newer than
-//! \p layout_path (or any, when \p layout_path is empty or missing). Never throws.
-std::optional<AutosaveOffer> find_autosave(const std::string& mesh_path,
-                                           const std::string& layout_path);
+//! The autosave, when one exists and is worth offering: readable, with its "autosave" block,
+//! and not older than the layout file it was editing (a save after it supersedes it).
+//! Whatever file is open: a crash leaves edits to any mesh. Never throws.
+std::optional<AutosaveOffer> find_autosave();
+//! The same, only when it belongs to the mesh file \p mesh_path.
+std::optional<AutosaveOffer> find_autosave(const std::string& mesh_path);
+
+//! Deletes the autosave (its edits were saved). Never throws.
+void remove_autosave();
+//! Renames the autosave to autosave_dir()/autosave.previous.layout.json (so that a new
+//! session's autosave does not overwrite edits that were never restored). Returns the new
+//! path, "" when there was nothing to move or it failed. Never throws.
+std::string set_autosave_aside();
 
 }  // namespace qs::app

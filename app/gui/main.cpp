@@ -24,7 +24,8 @@ int run_editor(int argc, char** argv) {
                  "Save the window as PNG after the run finishes (or after --frames frames)");
   cli.add_option("--frames", options.frames, "Number of frames before the screenshot / quit")
       ->check(CLI::PositiveNumber);
-  cli.add_flag("--quit", options.quit, "Exit after the screenshot");
+  cli.add_flag("--quit", options.quit,
+               "Exit after the screenshot (files that cannot be opened: exit code 2 at once)");
   cli.add_option("--bench-frames", options.bench_frames,
                  "Frame-time benchmark: render N frames (after 10 warm-up frames), print mean "
                  "and 95th-percentile frame time and fps, and quit")
@@ -54,6 +55,12 @@ int run_editor(int argc, char** argv) {
       ->check(CLI::Range(0, 19));
   cli.add_flag("--frame-profile", options.frame_profile,
                "Print the mean time per frame stage (waiting for the GPU between stages) at exit");
+  cli.add_option("--script", options.script_path,
+                 "Automation: run the editor commands of this file, one per frame (see "
+                 "docs/interfaces.md)")
+      ->check(CLI::ExistingFile);
+  cli.add_option("--state-json", options.state_path,
+                 "Automation: write the editor's state as JSON to this file at exit");
   cli.add_option("--width", options.width, "Window width")->check(CLI::Range(200, 8192));
   cli.add_option("--height", options.height, "Window height")->check(CLI::Range(200, 8192));
   CLI11_PARSE(cli, argc, argv);

@@ -40,7 +40,8 @@ struct JobState {
   Layout layout;                // current layout (node vertices, re-routed arcs)
   PipelineOptions options;      // fixed when the job starts (WorkerOptions of that moment)
   NodeOptOptions node_options;  // fixed when the job starts
-  std::set<int> pinned_in_layout;  // nodes pinned in the editor's layout (stay pinned)
+  std::set<int> pinned_in_layout;       // nodes pinned in the editor's layout
+  std::set<int> arcs_pinned_in_layout;  // arcs pinned in the editor's layout
   double energy = 0;
   StepMetrics metrics;  // of the last displayed state (repeated for rejected steps)
   //! Solved (field + parameterization) at exactly (mesh, layout), or null: the display reuses
@@ -201,13 +202,28 @@ StepResult solve_for_display(JobState& job, WorkerState& state, const WorkerObse
   return result;
 }
 
-// The UI's pins (node id -> vertex) per node of \p layout: pinned nodes stay where they are
-// (the UI pins a node at its current vertex); a cleared pin releases the node unless the
-// editor's layout pinned it.
+// The pins in force per node of \p layout: the editor layout's pins, minus the nodes released
+// during the run (ClearPin), plus those pinned during the run (SetPin; a pinned node stays where
+// it is: the UI pins a node at its current vertex).
 std::vector<char> pin_flags(const WorkerState& state, const JobState& job, const Layout& layout) {
   std::vector<char> flags;
   for (const auto& node : layout.nodes)
-    flags.push_back(job.pinned_in_layout.count(node.id) > 0 || state.pins.count(node.id) > 0);
+    flags.push_back(
+        (job.pinned_in_layout.count(node.id) > 0 && state.released.count(node.id) == 0) ||
+        state.pins.count(node.id) > 0);
+  return flags;
+}
+
+// The pins in force per arc of \p layout: the editor layout's, overridden by those set during the
+// run (SetArcPin). A pinned arc keeps its route and its end nodes.
+std::vector<char> arc_pin_flags(const WorkerState& state, const JobState& job,
+                                const Layout& layout) {
+  std::vector<char> flags;
+  for (const auto& arc : layout.arcs) {
+    const auto it = state.arc_pins.find(arc.id);
+    flags.push_back(it != state.arc_pins.end() ? it->second
+                                               : job.arcs_pinned_in_layout.count(arc.id) > 0);
+  }
   return flags;
 }
 
@@ -250,6 +266,8 @@ StepResult pipeline_step(WorkerState& state, const WorkerObserver& observer) {
     }
     for (const auto& node : job->layout.nodes)
       if (node.pinned) job->pinned_in_layout.insert(node.id);
+    for (const auto& arc : job->layout.arcs)
+      if (arc.pinned) job->arcs_pinned_in_layout.insert(arc.id);
     state.user = job;
     const bool last = !state.options.node_optimization || state.options.max_steps <= 1;
     // Fixed nodes with fold-over removal: the solve checks for fold-overs and runs the
@@ -289,7 +307,8 @@ StepResult pipeline_step(WorkerState& state, const WorkerObserver& observer) {
                                                      job->node_options, &cancel, start_pipeline);
   }
   NodeOptimizer& optimizer = *job->optimizer;
-  optimizer.set_pinned(pin_flags(state, *job, optimizer.layout()));
+  optimizer.set_pinned(pin_flags(state, *job, optimizer.layout()),
+                       arc_pin_flags(state, *job, optimizer.layout()));
   const size_t reports_before = optimizer.reports().size();
   const bool more = optimizer.step(&cancel);
   const bool last = !more || state.iteration + 1 >= state.options.max_steps;
@@ -369,6 +388,8 @@ StepResult pipeline_step(WorkerState& state, const WorkerObserver& observer) {
   // Pins shown on the traced layout: the ones in force.
   const std::vector<char> pins = pin_flags(state, *job, state.layout);
   for (size_t n = 0; n < state.layout.nodes.size(); ++n) state.layout.nodes[n].pinned = pins[n];
+  const std::vector<char> arc_pins = arc_pin_flags(state, *job, state.layout);
+  for (size_t a = 0; a < state.layout.arcs.size(); ++a) state.layout.arcs[a].pinned = arc_pins[a];
   std::ostringstream ss;
   ss << prefix;
   if (!result.message.empty()) ss << ": " << result.message;

@@ -22,6 +22,7 @@ void RecentFiles::load(const fs::path& path) {
   path_ = path;
   meshes_.clear();
   layouts_.clear();
+  last_save_.clear();
   try {
     std::error_code ec;
     if (path.empty() || !fs::exists(path, ec)) return;
@@ -30,6 +31,8 @@ void RecentFiles::load(const fs::path& path) {
       if (m.is_string()) meshes_.push_back(m.get<std::string>());
     for (const auto& l : json.value("layouts", nlohmann::json::array()))
       if (l.is_string()) layouts_.push_back(l.get<std::string>());
+    if (json.contains("last_save") && json.at("last_save").is_string())
+      last_save_ = json.at("last_save").get<std::string>();
   } catch (const std::exception&) {
     meshes_.clear();  // corrupt file: start over, it is only a convenience
     layouts_.clear();
@@ -40,7 +43,8 @@ bool RecentFiles::save() const {
   if (path_.empty()) return false;
   try {
     fs::create_directories(path_.parent_path());
-    const nlohmann::json json = {{"meshes", meshes_}, {"layouts", layouts_}};
+    const nlohmann::json json = {
+        {"meshes", meshes_}, {"layouts", layouts_}, {"last_save", last_save_}};
     write_file_atomic(path_.string(), json.dump(2) + "\n");
     return true;
   } catch (const std::exception&) {
@@ -55,6 +59,12 @@ void RecentFiles::add(std::vector<std::string>& list, const std::string& path) {
   std::erase(list, entry);
   list.insert(list.begin(), entry);
   if (list.size() > max_entries) list.resize(max_entries);
+}
+
+void RecentFiles::set_last_save(const std::string& path) {
+  std::error_code ec;
+  const fs::path absolute = fs::absolute(path, ec);
+  last_save_ = ec ? path : absolute.lexically_normal().string();
 }
 
 void RecentFiles::add_mesh(const std::string& path) {

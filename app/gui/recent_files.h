@@ -21,6 +21,9 @@ class RecentFiles {
   void add_layout(const std::string& path);
   const std::vector<std::string>& meshes() const { return meshes_; }
   const std::vector<std::string>& layouts() const { return layouts_; }
+  //! The file the last layout was saved to ("" before the first save).
+  const std::string& last_save() const { return last_save_; }
+  void set_last_save(const std::string& path);
 
   std::size_t max_entries = 10;
 
@@ -29,6 +32,7 @@ class RecentFiles {
   std::filesystem::path path_;
   std::vector<std::string> meshes_;
   std::vector<std::string> layouts_;
+  std::string last_save_;
 };
 
 }  // namespace qs::app

@@ -1042,23 +1042,46 @@ struct NodeOptimizer::Impl {
     current_solved = true;
   }
 
-  // Pins changed between steps (NodeOptimizer::set_pinned).
-  void set_pinned(const std::vector<char>& pinned) {
+  // Pins changed between steps (NodeOptimizer::set_pinned): per node and, when \p arc_pinned is
+  // not empty, per arc (both by index).
+  void set_pinned(const std::vector<char>& pinned, const std::vector<char>& arc_pinned) {
     bool changed = false;
+    // An earlier state in which a newly pinned node or arc stands elsewhere is no fallback any
+    // more: the node's vertex or its position, an arc's route or its end nodes' vertices.
+    auto node_differs = [&](const State& st, size_t n) {
+      const int v = state.layout.nodes[n].vertex;
+      const auto vh = original.vertex_handle(v);
+      return st.layout.nodes[n].vertex != v || st.mesh.point(vh) != state.mesh.point(vh);
+    };
+    auto arc_differs = [&](const State& st, size_t a) {
+      const LayoutArc& arc = state.layout.arcs[a];
+      if (st.layout.arcs[a].path != arc.path) return true;
+      for (int id : {arc.from, arc.to}) {
+        const int n = state.layout.node_index(id);
+        if (n >= 0 && node_differs(st, size_t(n))) return true;
+      }
+      return false;
+    };
     for (size_t n = 0; n < state.layout.nodes.size() && n < pinned.size(); ++n) {
       LayoutNode& node = state.layout.nodes[n];
       if (node.pinned == bool(pinned[n])) continue;
       changed = true;
       node.pinned = pinned[n];
-      // An earlier state where a newly pinned node stands elsewhere is no fallback any more.
-      const auto vh = original.vertex_handle(node.vertex);
       for (std::unique_ptr<State>* earlier : {&pre_polish, &fewest_folds, &initial_state}) {
         if (!*earlier) continue;
-        State& st = **earlier;
-        st.layout.nodes[n].pinned = node.pinned;
-        if (node.pinned &&
-            (st.layout.nodes[n].vertex != node.vertex || st.mesh.point(vh) != state.mesh.point(vh)))
-          earlier->reset();
+        (*earlier)->layout.nodes[n].pinned = node.pinned;
+        if (node.pinned && node_differs(**earlier, n)) earlier->reset();
+      }
+    }
+    for (size_t a = 0; a < state.layout.arcs.size() && a < arc_pinned.size(); ++a) {
+      LayoutArc& arc = state.layout.arcs[a];
+      if (arc.pinned == bool(arc_pinned[a])) continue;
+      changed = true;
+      arc.pinned = arc_pinned[a];
+      for (std::unique_ptr<State>* earlier : {&pre_polish, &fewest_folds, &initial_state}) {
+        if (!*earlier) continue;
+        (*earlier)->layout.arcs[a].pinned = arc.pinned;
+        if (arc.pinned && arc_differs(**earlier, a)) earlier->reset();
       }
     }
     if (!changed) return;
@@ -1357,11 +1380,14 @@ bool NodeOptimizer::step(Observer* observer) {
   return impl_->step();
 }
 
-void NodeOptimizer::set_pinned(const std::vector<char>& pinned) {
+void NodeOptimizer::set_pinned(const std::vector<char>& pinned,
+                               const std::vector<char>& arc_pinned) {
   if (impl_->finished) throw std::logic_error("NodeOptimizer::set_pinned after finish");
   if (pinned.size() != impl_->state.layout.nodes.size())
     throw std::invalid_argument("NodeOptimizer::set_pinned: one flag per layout node expected");
-  impl_->set_pinned(pinned);
+  if (!arc_pinned.empty() && arc_pinned.size() != impl_->state.layout.arcs.size())
+    throw std::invalid_argument("NodeOptimizer::set_pinned: one flag per layout arc expected");
+  impl_->set_pinned(pinned, arc_pinned);
 }
 
 const TriMesh& NodeOptimizer::mesh() const {

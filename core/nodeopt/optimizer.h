@@ -343,10 +343,14 @@ class NodeOptimizer {
   //! Runs the next unit. False when the descent and the polish are over (a last hop sweep that
   //! kept nothing may have run in this call): call finish(). \throw Cancelled, SolverError.
   bool step(Observer* observer = nullptr);
-  //! Pins (one flag per layout node, by index) for the next steps: a pinned node does not move
-  //! from now on, a released one may. An earlier state kept for the fold-over removal in which
-  //! a newly pinned node stands elsewhere is dropped.
-  void set_pinned(const std::vector<char>& pinned);
+  //! Pins for the next steps: \p pinned has one flag per layout node, \p arc_pinned one per
+  //! layout arc (by index into layout().nodes / layout().arcs; empty: the arcs' flags stay).
+  //! A pinned node does not move from now on, a released one may. A pinned arc holds its end
+  //! nodes (as pinned nodes) and its route (no end moves, so it is never re-routed). An earlier
+  //! state kept for the fold-over removal in which a newly pinned node, or a newly pinned arc's
+  //! route or end nodes, stands elsewhere is dropped.
+  //! \throw std::invalid_argument on a wrong number of flags, std::logic_error after finish().
+  void set_pinned(const std::vector<char>& pinned, const std::vector<char>& arc_pinned = {});
 
   //! The current (last accepted) state.
   const TriMesh& mesh() const;

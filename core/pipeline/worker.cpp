@@ -81,6 +81,12 @@ std::uint64_t Worker::send(Command command) {
         return old && old->node_id == pin->node_id;
       });
     }
+    if (const auto* pin = std::get_if<cmd::SetArcPin>(&command)) {
+      std::erase_if(queue_, [&](const Queued& q) {
+        const auto* old = std::get_if<cmd::SetArcPin>(&q.command);
+        return old && old->arc_id == pin->arc_id;
+      });
+    }
     // Bump the generation before the worker can see the command, so that a step that is
     // running right now sees should_cancel() and stops early.
     if (is_structural(command)) generation_.fetch_add(1, std::memory_order_acq_rel);
@@ -201,6 +207,11 @@ void Worker::run(std::stop_token stop) {
                        step_budget = 0;
                        reset_job();
                        set_layout(std::move(c.layout));
+                       state.pins.clear();
+                       state.released.clear();
+                       state.arc_pins.clear();
+                       state.pins_changed = true;
+                       pending_pin_seq = 0;
                        current.generation = generation_.load();
                        current.status = WorkerStatus::Idle;
                        current.message = "layout changed";
@@ -241,11 +252,18 @@ void Worker::run(std::stop_token stop) {
                      },
                      [&](cmd::SetPin& c) {
                        state.pins[c.node_id] = c.vertex;
+                       state.released.erase(c.node_id);
                        state.pins_changed = true;
                        if (!pending_pin_seq) pending_pin_seq = queued.seq;
                      },
                      [&](cmd::ClearPin& c) {
                        state.pins.erase(c.node_id);
+                       state.released.insert(c.node_id);
+                       state.pins_changed = true;
+                       if (!pending_pin_seq) pending_pin_seq = queued.seq;
+                     },
+                     [&](cmd::SetArcPin& c) {
+                       state.arc_pins[c.arc_id] = c.pinned;
                        state.pins_changed = true;
                        if (!pending_pin_seq) pending_pin_seq = queued.seq;
                      },

@@ -16,6 +16,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <stop_token>
 #include <string>
 #include <thread>
@@ -91,8 +92,13 @@ class WorkerObserver : public Observer {
 //! Mutable algorithm state, owned by the worker thread.
 struct WorkerState {
   std::shared_ptr<const TriMesh> mesh;
-  Layout layout;              //!< the job's current layout
-  std::map<int, int> pins;    //!< node id -> target vertex (SetPin / ClearPin)
+  Layout layout;            //!< the job's current layout
+  std::map<int, int> pins;  //!< node id -> target vertex (SetPin)
+  //! Node ids released by ClearPin: unpinned also when the job's layout pins them.
+  std::set<int> released;
+  //! Arc id -> pinned (SetArcPin), overriding the job's layout. A pinned arc keeps its route
+  //! and its end nodes.
+  std::map<int, bool> arc_pins;
   bool pins_changed = false;  //!< set when pins changed since the last step
   WorkerOptions options;
   int iteration = 0;  //!< steps done in this job (incremented by the worker)
@@ -134,20 +140,29 @@ struct SetPin {
   int node_id = -1;
   int vertex = -1;
 };
+//! Releases the node: also one the job's layout pins.
 struct ClearPin {
   int node_id = -1;
+};
+//! Pins (or releases) an arc: its route and end nodes stay where they are.
+struct SetArcPin {
+  int arc_id = -1;
+  bool pinned = true;
 };
 struct SetOptions {
   WorkerOptions options;
 };
-struct SetLayout {  //!< replace the layout (after an edit); cancels a running job
+//! Replaces the layout (after an edit); cancels a running job and drops the pins of SetPin,
+//! ClearPin and SetArcPin (the new layout carries its own).
+struct SetLayout {
   Layout layout;
 };
 struct Shutdown {};
 }  // namespace cmd
 
-using Command = std::variant<cmd::LoadMesh, cmd::Run, cmd::Pause, cmd::Step, cmd::Stop, cmd::SetPin,
-                             cmd::ClearPin, cmd::SetOptions, cmd::SetLayout, cmd::Shutdown>;
+using Command =
+    std::variant<cmd::LoadMesh, cmd::Run, cmd::Pause, cmd::Step, cmd::Stop, cmd::SetPin,
+                 cmd::ClearPin, cmd::SetArcPin, cmd::SetOptions, cmd::SetLayout, cmd::Shutdown>;
 
 class Worker {
  public:
@@ -160,7 +175,8 @@ class Worker {
 
   //! Enqueues a command and returns its seq number (1, 2, ...). Thread-safe.
   //! Structural commands (LoadMesh, SetLayout, Stop, Shutdown) cancel the running step at once.
-  //! A SetPin replaces a still-queued SetPin for the same node (the latest one wins).
+  //! A SetPin replaces a still-queued SetPin for the same node, a SetArcPin one for the same
+  //! arc (the latest one wins).
   std::uint64_t send(Command command);
 
   //! The latest published snapshot (never null). Cheap: copies a shared_ptr under the lock.

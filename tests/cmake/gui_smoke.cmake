@@ -1,5 +1,6 @@
-# GUI tests: the layout editor unit (GL-free app code) and smoke tests of the quadsketch
-# executable (screenshot under Xvfb, exit codes). Included by tests/CMakeLists.txt.
+# GUI tests: the layout editor unit and the editor's state (GL-free app code), the editor end to
+# end under Xvfb (gui_app_test, driven by --script), and smoke tests of the quadsketch
+# executable (screenshots, exit codes). Included by tests/CMakeLists.txt.
 
 # layout_editor_test.cpp is picked up by the *_test.cpp glob, which links qs_core only: add
 # the app sources it exercises (all GL-free).
@@ -37,8 +38,30 @@ if(TARGET gui_frame_test)
   endif()
 endif()
 
+# gui_editor_test.cpp: the editor's state (GL-free) with its real pipeline job; with the render
+# library also the key map, the camera views and the state dump.
+if(TARGET gui_editor_test)
+  foreach(src editor job_control pipeline_job autosave recent_files layout_editor document
+      thread_priority file_browser plot_ticks ui_text)
+    target_sources(gui_editor_test PRIVATE ${PROJECT_SOURCE_DIR}/app/gui/${src}.cpp)
+  endforeach()
+  if(TARGET qs_render)
+    target_sources(gui_editor_test PRIVATE ${PROJECT_SOURCE_DIR}/app/gui/actions.cpp
+      ${PROJECT_SOURCE_DIR}/app/gui/tools.cpp ${PROJECT_SOURCE_DIR}/app/gui/state_dump.cpp)
+    target_link_libraries(gui_editor_test PRIVATE qs_render)
+    target_compile_definitions(gui_editor_test PRIVATE QS_TEST_RENDER)
+  endif()
+endif()
+
 if(NOT QS_BUILD_APP)
   return()
+endif()
+
+# gui_app_test.cpp: the editor end to end under Xvfb, driven by --script, checked on its
+# --state-json dumps.
+if(TARGET gui_app_test)
+  add_dependencies(gui_app_test quadsketch)
+  target_compile_definitions(gui_app_test PRIVATE QS_GUI_APP="$<TARGET_FILE:quadsketch>")
 endif()
 
 add_executable(gui_smoke_check ${CMAKE_CURRENT_LIST_DIR}/../gui_smoke_check.cpp)

@@ -1,4 +1,4 @@
-#include "app/gui/screenshot.h"
+#include "render/screenshot.h"
 
 #ifndef GL_GLEXT_PROTOTYPES
 #define GL_GLEXT_PROTOTYPES
@@ -11,7 +11,7 @@
 
 #include "core/base/atomic_file.h"
 
-namespace qs::app {
+namespace qs::render {
 
 bool save_framebuffer_png(const std::string& path, int width, int height, std::string* error) {
   if (width <= 0 || height <= 0) {
@@ -45,4 +45,4 @@ bool save_framebuffer_png(const std::string& path, int width, int height, std::s
   return true;
 }
 
-}  // namespace qs::app
+}  // namespace qs::render

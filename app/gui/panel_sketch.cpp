@@ -1,0 +1,48 @@
+// Sketch: the tools, undo / redo, the mouse and keyboard reference.
+#include <cstdio>
+
+#include "app/gui/panels.h"
+
+namespace qs::app {
+
+void draw_sketch_panel(AppContext& ctx) {
+  if (!ImGui::CollapsingHeader("Sketch", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  Editor& editor = ctx.editor;
+  for (int i = 0; i < kToolCount; ++i) {
+    const Tool t = static_cast<Tool>(i);
+    char label[64];
+    std::snprintf(label, sizeof(label), "%d %s", i + 1, tool_name(t));
+    if (i % 2 == 1) ImGui::SameLine(11.0f * ImGui::GetFontSize());
+    if (ImGui::RadioButton(label, ctx.tools.tool() == t)) ctx.tools.set_tool(t);
+    tooltip(std::string(tool_hint(t)) + " (key " + std::to_string(i + 1) + ")");
+  }
+  text_wrapped(tool_hint(ctx.tools.tool()));
+  const LayoutEditor& layout_editor = editor.doc.editor;
+  if (!layout_editor.can_undo()) ImGui::BeginDisabled();
+  if (ImGui::Button("Undo")) {
+    editor.undo();
+    ctx.tools.sync(editor);
+  }
+  tooltip("Ctrl+Z");
+  if (!layout_editor.can_undo()) ImGui::EndDisabled();
+  ImGui::SameLine();
+  if (!layout_editor.can_redo()) ImGui::BeginDisabled();
+  if (ImGui::Button("Redo")) {
+    editor.redo();
+    ctx.tools.sync(editor);
+  }
+  tooltip("Ctrl+Shift+Z or Ctrl+Y");
+  if (!layout_editor.can_redo()) ImGui::EndDisabled();
+  ImGui::SameLine();
+  if (layout_editor.can_undo()) text_colored(kDimColor, "last: " + layout_editor.undo_label());
+  help_marker(
+      "Mouse: left drag turns the view (turntable; trackball in the View panel), right or "
+      "middle drag pans, the wheel zooms.\n"
+      "Keys: 1-8 tools, Del delete, P pin, Esc cancel, Ctrl+Z undo, Ctrl+Shift+Z / Ctrl+Y "
+      "redo, Ctrl+O open, Ctrl+S save, Ctrl+Shift+S save as.\n"
+      "View (numpad, as in Blender): 1 front, 3 right, 7 top (with Ctrl: back, left, bottom), "
+      "5 perspective / orthographic, 4 6 8 2 turn by 15 degrees, . or F frame the selection, "
+      "Home frame all, R reset.");
+}
+
+}  // namespace qs::app
