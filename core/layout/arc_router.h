@@ -4,6 +4,7 @@
 // (docs/design.md, "Discretizing a layout").
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include "core/mesh/working_mesh.h"
@@ -20,6 +21,8 @@ class LayoutOccupancy {
 
   //! Grows the arrays to the working mesh's current vertex and edge counts (new elements free).
   void sync();
+  //! Frees every element (and resizes the arrays to the working mesh).
+  void clear();
   //! Marks node \p node on vertex \p v (-1 clears it).
   void set_node(int v, int node);
   //! Marks the interior vertices of \p path and all its edges as used by \p arc (-1 frees
@@ -44,26 +47,44 @@ struct RouteRequest {
   int source = -1;  //!< working-mesh vertex where the path starts
   int target = -1;  //!< working-mesh vertex where it ends; -1: the nearest free boundary vertex
   //! 3D points the path should follow (from source to target), or empty. The path's cost grows
-  //! with the distance from this polyline (corridor), and a guided search gives up past
-  //! max_length_factor × the guide's length (plus a few edge lengths).
+  //! with the distance from this polyline (corridor), and a guided search gives up on paths
+  //! longer than max_length_factor × the guide's length (plus a few corridor widths).
   std::vector<Vec3> guide;
   //! Corridor half-width (length units); <= 0: twice the mean edge length around the source.
   double guide_width = 0;
   double max_length_factor = 3.0;
   //! Vertices next to other nodes cost this many times their length (each node's 1-ring is
   //! kept for its own arcs where possible).
-  double foreign_ring_cost = 20.0;
+  double foreign_ring_cost = 4.0;
+  //! Passes that move the route's new vertices towards the straight line between their path
+  //! neighbours (inside their input face or along their input edge); 0: midpoints as found.
+  int straighten = 4;
 };
 
 //! Finds a path for \p request on \p mesh that avoids every occupied vertex (other than the
 //! path's ends) and every arc edge, moving along free edges or across faces through the
 //! midpoints of free interior edges, then realizes it: each midpoint becomes a vertex by
-//! splitting its edge (WorkingMesh::split_edge, exact). Returns the vertex path (source first,
+//! splitting its edge (WorkingMesh::split_edge, exact), and straightens it (RouteRequest::
+//! straighten). Returns the vertex path (source first,
 //! at least two vertices), or an empty path when no route exists (then nothing is changed, or,
 //! rarely, a realization that could not join two of its vertices left its exact splits).
 //! \p occupancy is synced but not marked: the caller marks the returned path.
-//! \p splits, when given, is increased by the number of edges split.
+//! \p splits, when given, is increased by the number of edges split; \p split_log, when given,
+//! receives (a, b, m) for every edge (a, b) split at a new vertex m.
 std::vector<int> route_arc(WorkingMesh& mesh, LayoutOccupancy& occupancy,
-                           const RouteRequest& request, int* splits = nullptr);
+                           const RouteRequest& request, int* splits = nullptr,
+                           std::vector<std::array<int, 3>>* split_log = nullptr);
+
+//! The straight path on the surface from vertex \p source to vertex \p target: from each
+//! vertex, the line towards the target (in the plane of the face whose corner wedge holds that
+//! direction) crosses the opposite edge, which is split there (exact), or passes through an end
+//! of that edge when the crossing is within \p snap (fraction of the edge) of it. Only free
+//! vertices and free edges are used (\p occupancy, synced, not marked). Returns the vertex path
+//! (source first), or an empty path when the line meets (or passes within the snap distance of)
+//! an occupied vertex, an arc edge or the boundary, or strays (the splits made until then stay: free
+//! refinement vertices, logged like route_arc's in \p split_log).
+std::vector<int> route_straight(WorkingMesh& mesh, LayoutOccupancy& occupancy, int source,
+                                int target, double snap = 0.15, int* splits = nullptr,
+                                std::vector<std::array<int, 3>>* split_log = nullptr);
 
 }  // namespace qs

@@ -257,8 +257,8 @@ EmbeddedLayout embed_layout(std::shared_ptr<const TriMesh> input, const Layout& 
   }
   layout.feature_edges = std::move(features);
   for (LayoutNode& node : layout.nodes) node.point = w.origin(node.vertex);
-  layout.mesh_vertices = static_cast<int>(m.n_vertices());
-  layout.mesh_faces = static_cast<int>(m.n_faces());
+  // The working mesh changes as nodes move: the layout names no mesh size.
+  layout.mesh_vertices = layout.mesh_faces = -1;
   return result;
 }
 

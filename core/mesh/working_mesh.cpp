@@ -237,6 +237,23 @@ std::optional<std::array<double, 3>> WorkingMesh::point_in_input_face(const Surf
   return out;
 }
 
+SurfacePoint WorkingMesh::input_point(int face, const std::array<double, 3>& bary) const {
+  check_face(face, "input_point");
+  const int h = host_[face];
+  const auto c = corners(face);
+  Bary w{std::clamp(bary[0], 0.0, 1.0), std::clamp(bary[1], 0.0, 1.0),
+         std::clamp(bary[2], 0.0, 1.0)};
+  const double sum = w[0] + w[1] + w[2];
+  SurfacePoint out;
+  out.face = h;
+  out.bary = {0, 0, 0};
+  for (int k = 0; k < 3; ++k) {
+    const Bary b = host_bary(c[k], h);
+    for (int j = 0; j < 3; ++j) out.bary[j] += (sum > 0 ? w[k] / sum : 1.0 / 3) * b[j];
+  }
+  return out;
+}
+
 std::optional<std::array<double, 3>> WorkingMesh::bary_in_input_face(int v, int input_face) const {
   check_vertex(v, "bary_in_input_face");
   return point_in_input_face(origin_[v], input_face);
@@ -514,7 +531,8 @@ int WorkingMesh::split_face(int face, const std::array<double, 3>& bary) {
 // ---- insertion ----
 
 WorkingMesh::Inserted WorkingMesh::insert_point(const SurfacePoint& p_in,
-                                                const std::function<bool(int)>& may_reuse) {
+                                                const std::function<bool(int)>& may_reuse,
+                                                const std::function<bool(int)>& may_split) {
   const SurfacePoint p = checked_point(p_in, "insert_point");
   const Location loc = locate_in(p);
   const int f = loc.face;
@@ -563,6 +581,15 @@ WorkingMesh::Inserted WorkingMesh::insert_point(const SurfacePoint& p_in,
     OpenMesh::SmartHalfedgeHandle h = mesh_.find_halfedge(VH(a), VH(b));
     const int edge = h.edge().idx();
     const bool forward = mesh_.halfedge_handle(EH(edge), 0) == h;
+    if (may_split && !may_split(edge)) {
+      if (loc.bary[k] == 0) {
+        throw InvalidInputError("insert_point: the point " + bary_text(p.bary) +
+                                " of input face " + std::to_string(p.face) +
+                                " lies on working-mesh edge " + std::to_string(edge) +
+                                ", which may not be split");
+      }
+      continue;
+    }
     if (loc.bary[k] == 0) {
       // p lies on this edge. Its origin is p itself unless the edge runs along an input edge
       // and p's weights do not say so (then the edge's own interpolation is used).
@@ -603,6 +630,33 @@ WorkingMesh::Inserted WorkingMesh::insert_point(const SurfacePoint& p_in,
       break;
     }
     if (!best || cand.min_angle > best->min_angle) best = &cand;
+  }
+  // No candidate meets the bar (p close to a vertex that may not be reused or an edge that may
+  // not be split): p is moved towards the centre of f until its 1→3 split does.
+  // On an edge of f, p moves along that edge towards its middle instead.
+  Candidate moved;
+  const int zeros = zero_count(loc.bary);
+  for (double s : {0.25, 0.5, 0.75}) {
+    if (chosen || zeros > 1) break;
+    Bary b;
+    for (int k = 0; k < 3; ++k)
+      b[k] = loc.bary[k] == 0 ? 0.0 : (1 - s) * loc.bary[k] + s / (3 - zeros);
+    if (zeros == 1) {
+      int k0 = 0;
+      while (loc.bary[k0] != 0) ++k0;
+      const int a = c[(k0 + 1) % 3], bv = c[(k0 + 2) % 3];
+      const OpenMesh::SmartHalfedgeHandle h = mesh_.find_halfedge(VH(a), VH(bv));
+      const int edge = h.edge().idx();
+      if (may_split && !may_split(edge)) break;
+      const bool forward = mesh_.halfedge_handle(EH(edge), 0) == h;
+      const double t = b[(k0 + 2) % 3] / (b[(k0 + 1) % 3] + b[(k0 + 2) % 3]);
+      moved = edge_split_candidate(edge, edge_point(edge, forward ? t : 1 - t));
+    } else {
+      moved = face_split_candidate(f, face_point(f, b));
+    }
+    moved.exact = false;
+    if (evaluate(moved) && moved.min_angle >= std::min(options_.min_angle_deg, moved.old_angle))
+      chosen = &moved;
   }
   if (!chosen) chosen = best;
   if (!chosen) {

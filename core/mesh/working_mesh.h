@@ -94,6 +94,10 @@ class WorkingMesh {
   //! \throw InvalidInputError if p's face is out of range or its barycentrics are outside the
   //! face (a component below -1e-9, non-finite, or a sum more than 1e-6 from 1).
   Location locate(const SurfacePoint& p) const;
+  //! The input surface point of the point with barycentrics \p bary (w.r.t. the corners of W
+  //! face \p face, face-vertex order): a point of the face's host. Weights are clamped to
+  //! [0, 1] and normalized. \throw InvalidInputError for an invalid face.
+  SurfacePoint input_point(int face, const std::array<double, 3>& bary) const;
   //! Barycentrics of W vertex v in input face f (v must lie on f's closure, else nullopt).
   std::optional<std::array<double, 3>> bary_in_input_face(int v, int input_face) const;
   //! Barycentrics of surface point p in input face f (p on f's closure, else nullopt).
@@ -139,12 +143,17 @@ class WorkingMesh {
   //! 3. the exact 1→3 split of f at p.
   //! The first candidate whose new triangles are positively oriented with smallest angle
   //! >= min(min_angle_deg, smallest angle of the faces it splits) is taken. When no candidate
-  //! meets that bar, the valid split with the largest smallest angle is taken (so a triangle
-  //! below the bar is only created where every candidate creates one, e.g. p close to a vertex
-  //! that may not be reused, or inside an already bad face).
+  //! meets that bar (p close to a vertex that may not be reused or an edge that may not be
+  //! split, or on an edge near its end), p is moved a quarter, a half, then three quarters of the
+  //! way towards the centre of f (of its edge, when p lies on one of f's edges) and the first of
+  //! those splits that meets the bar is taken (not exact); failing that, the valid split with the
+  //! largest smallest angle (inside an already bad face).
+  //! Edges for which \p may_split (when given) returns false are never split (an arc's edges):
+  //! p then gets a face split even when it is within ε of such an edge.
   //! \throw InvalidInputError for an invalid p, or when no vertex can be placed (p coincides
-  //! with a vertex that may not be reused).
-  Inserted insert_point(const SurfacePoint& p, const std::function<bool(int)>& may_reuse = {});
+  //! with a vertex that may not be reused, or lies on an edge that may not be split).
+  Inserted insert_point(const SurfacePoint& p, const std::function<bool(int)>& may_reuse = {},
+                        const std::function<bool(int)>& may_split = {});
 
   //! Flips an edge whose two faces have the same host and form a strictly convex quad (in the
   //! host's barycentric coordinates), when the new edge does not exist yet. False (nothing
@@ -166,8 +175,9 @@ class WorkingMesh {
   //! Removes a refinement vertex by collapsing it into a neighbour u such that every remaining
   //! triangle of its star stays in its host and positively oriented: for a vertex interior to
   //! its host any neighbour, for a vertex on an input edge a neighbour on the same closed input
-  //! edge. Among valid neighbours, the one giving the largest smallest angle is chosen. False
-  //! (nothing changed) when v is an input vertex or no collapse is valid. Marks v, the faces
+  //! edge. Among valid neighbours, the one giving the largest smallest angle is chosen; it must
+  //! reach min(min_angle_deg, the star's smallest angle before). False (nothing changed) when v
+  //! is an input vertex or no collapse is valid. Marks v, the faces
   //! beside edge (v, u) and the edges merged away deleted; call compact() afterwards.
   bool remove_vertex(int v);
 

@@ -128,6 +128,10 @@ bool WorkingMesh::remove_vertex(int v) {
     }
   }
   if (!best.is_valid()) return false;
+  // A collapse never makes the mesh worse than the quality bar where it was not already.
+  double old_angle = 180;
+  for (auto f : mesh_.vf_range(VH(v))) old_angle = std::min(old_angle, face_min_angle_deg(f.idx()));
+  if (best_angle < std::min(options_.min_angle_deg, old_angle)) return false;
   std::vector<int> star;
   for (auto f : mesh_.vf_range(VH(v))) star.push_back(f.idx());
   mesh_.collapse(best);
