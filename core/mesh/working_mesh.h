@@ -179,7 +179,9 @@ class WorkingMesh {
   //! reach min(min_angle_deg, the star's smallest angle before). False (nothing changed) when v
   //! is an input vertex or no collapse is valid. Marks v, the faces
   //! beside edge (v, u) and the edges merged away deleted; call compact() afterwards.
-  bool remove_vertex(int v);
+  //! \p min_angle_deg >= 0 replaces the quality bar (0: any valid collapse, for a caller that
+  //! repairs angles afterwards, e.g. with improve()).
+  bool remove_vertex(int v, double min_angle_deg = -1);
 
   //! Maps from old to new indices (-1 for removed elements): vertex (size #V before), edge
   //! (size #E before), face (size #F before).

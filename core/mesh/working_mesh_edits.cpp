@@ -85,7 +85,7 @@ bool WorkingMesh::move_vertex(int v, const SurfacePoint& p) {
   return true;
 }
 
-bool WorkingMesh::remove_vertex(int v) {
+bool WorkingMesh::remove_vertex(int v, double min_angle_deg) {
   check_vertex(v, "remove_vertex");
   if (is_input_vertex(v)) return false;
   const SurfacePoint& o = origin_[v];
@@ -131,7 +131,8 @@ bool WorkingMesh::remove_vertex(int v) {
   // A collapse never makes the mesh worse than the quality bar where it was not already.
   double old_angle = 180;
   for (auto f : mesh_.vf_range(VH(v))) old_angle = std::min(old_angle, face_min_angle_deg(f.idx()));
-  if (best_angle < std::min(options_.min_angle_deg, old_angle)) return false;
+  const double bar = min_angle_deg >= 0 ? min_angle_deg : options_.min_angle_deg;
+  if (best_angle < std::min(bar, old_angle)) return false;
   std::vector<int> star;
   for (auto f : mesh_.vf_range(VH(v))) star.push_back(f.idx());
   mesh_.collapse(best);

@@ -299,17 +299,35 @@ int tidy_mesh_layout(MeshLayout& state, const std::vector<int>& candidates) {
     std::sort(list.begin(), list.end());
     list.erase(std::unique(list.begin(), list.end()), list.end());
     const int nv = static_cast<int>(w.mesh().n_vertices());
-    for (int v : list) {
-      if (v < 0 || v >= nv || w.is_input_vertex(v) || w.mesh().status(VH(v)).deleted()) continue;
-      if (occ.occupied(v)) continue;
-      if (!getenv("QS_NOREMOVE")) removed += w.remove_vertex(v);
+    // Several passes: a vertex whose collapse was invalid may collapse once a neighbour went.
+    for (int pass = 0; pass < 3; ++pass) {
+      int now = 0;
+      for (int v : list) {
+        if (v < 0 || v >= nv || w.is_input_vertex(v) || w.mesh().status(VH(v)).deleted()) continue;
+        if (occ.occupied(v)) continue;
+        now += w.remove_vertex(v, 0.0);
+      }
+      removed += now;
+      if (now == 0) break;
+    }
+    if (getenv("QS_DBG5")) {
+      int free_face = 0, free_edge = 0, failed_face = 0, failed_edge = 0;
+      std::vector<char> cand(w.mesh().n_vertices(), 0);
+      for (int v : list) if (v >= 0 && v < nv) cand[v] = 1;
+      for (int v = w.input_vertices(); v < nv; ++v) {
+        if (w.mesh().status(VH(v)).deleted() || occ.occupied(v)) continue;
+        const bool edge = w.carrier(v) == WorkingMesh::Carrier::kInputEdge;
+        (edge ? free_edge : free_face)++;
+        if (cand[v]) (edge ? failed_edge : failed_face)++;
+      }
+      fprintf(stderr, "tidy: removed %d; free refinement vertices left: %d in faces, %d on edges; of the candidates %d / %d\n", removed, free_face, free_edge, failed_face, failed_edge);
     }
   }
   // Angles repaired inside input faces (never an arc edge), then room between the arcs.
   {
     LayoutOccupancy occ(w);
     fill_occupancy(state, occ);
-    if (!getenv("QS_NOIMPROVE")) w.improve({}, [&](int e) { return occ.arc_on_edge(e) >= 0; });
+    w.improve({}, [&](int e) { return occ.arc_on_edge(e) >= 0; });
   }
   separate_layout(w, state.layout);
   const WorkingMesh::Compaction c = w.compact();

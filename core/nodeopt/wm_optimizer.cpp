@@ -178,7 +178,8 @@ struct WmOptimizer::Impl {
     const int faces_before = static_cast<int>(trial.mesh.mesh().n_faces());
     for (size_t i = 0; i < nodes.size(); ++i) {
       const double g = grad[i].norm();
-      const double len = alpha * scale * g;
+      double len = alpha * scale * g;
+      if (const char* cap = getenv("QS_CAP")) len = std::min(len, std::atof(cap) * mean_edge);
       if (!(len >= 1e-4 * mean_edge)) continue;
       const int n = nodes[i];
       // Traced on the state's working mesh (the same surface as the input), inside the cell.
@@ -246,6 +247,18 @@ struct WmOptimizer::Impl {
     try {
       if (broken) {
       } else if (relaid) {
+        // Free refinement vertices around the moved nodes go too (separation puts back the
+        // ones the arcs need): the mesh does not keep refining where nodes pass.
+        if (!getenv("QS_NOWIDE")) {
+          const TriMesh& tm = trial.mesh.mesh();
+          for (int n : nodes) {
+            const int v = trial.layout.nodes[n].vertex;
+            for (auto x : tm.vv_range(tm.vertex_handle(v))) {
+              freed.push_back(x.idx());
+              for (auto y : tm.vv_range(x)) freed.push_back(y.idx());
+            }
+          }
+        }
         tidy_mesh_layout(trial, freed);
         ok = count_patches(trial.mesh.mesh(), trial.layout) == patches;
         if (getenv("QS_DBG")) fprintf(stderr, "patches %d vs %d\n", count_patches(trial.mesh.mesh(), trial.layout), patches);
