@@ -105,11 +105,9 @@ TEST(WorkingMesh, TwoPointsInOneInputTriangleAreBothInserted) {
   EXPECT_TRUE(i3.created);
   EXPECT_NE(i3.vertex, i1.vertex);
   EXPECT_NE(i3.vertex, i2.vertex);
-  // Exactly there it would leave a sliver against the first: it is moved into the face.
-  EXPECT_FALSE(i3.exact);
-  double input_angle = 180;
-  for (auto face : input->faces()) input_angle = std::min(input_angle, face_min_angle(*input, face.idx()));
-  EXPECT_GE(wm.min_angle_deg(), std::min(wm.options().min_angle_deg, input_angle));
+  // Not exactly there (a sliver against the first), but never further than a snap.
+  EXPECT_LE((wm.mesh().point(VH(i3.vertex)) - wm.position(close)).norm(),
+            wm.options().snap * 1e-3 * diagonal(*input) + 1e-12);
   // Barycentrics that sum to 1 only within the files' tolerance are normalized: the vertex lies
   // on the input face's plane.
   const int g = f + 1;
@@ -185,9 +183,9 @@ TEST(WorkingMesh, InsertPointKeepsTheQualityBarOrDoesNoWorseThanExact) {
   }
 }
 
-// A point next to a vertex that may not be reused is moved into the face (not exact) rather
-// than leaving a sliver.
-TEST(WorkingMesh, PointNextToAForbiddenVertexMovesIntoTheFace) {
+// A point next to a vertex that may not be reused gets its own vertex, moved towards the face's
+// centre by at most the snap distance (not exact).
+TEST(WorkingMesh, PointNextToAForbiddenVertexGetsItsOwnVertexWithinSnap) {
   const auto input = share(disk_grid(4, 4, 2, 2).mesh);
   const int v = 6;  // the interior grid point (1, 1)
   const int f = input->vf_range(VH(v)).begin()->idx();
@@ -204,9 +202,9 @@ TEST(WorkingMesh, PointNextToAForbiddenVertexMovesIntoTheFace) {
   WorkingMesh forbid(input);
   const auto s = forbid.insert_point(p, [v](int u) { return u != v; });
   EXPECT_TRUE(s.created);
-  EXPECT_FALSE(s.exact);
-  EXPECT_GE(forbid.min_angle_deg(), forbid.options().min_angle_deg);
-  EXPECT_LE((forbid.mesh().point(VH(s.vertex)) - forbid.position(p)).norm(), 1.0);
+  EXPECT_NE(s.vertex, v);
+  EXPECT_LE((forbid.mesh().point(VH(s.vertex)) - forbid.position(p)).norm(),
+            forbid.options().snap * std::sqrt(2.0) + 1e-12);
   expect_exact(forbid, "after the forced insertion");
   // Exactly on a vertex that may not be reused: refused with the vertex named.
   SurfacePoint at{f, {{0, 0, 0}}};

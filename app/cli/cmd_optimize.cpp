@@ -429,6 +429,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
           {"fewest_foldovers_reverted", node_result->fewest_foldovers_reverted},
           {"initial_reverted", node_result->initial_reverted},
           {"untangled", node_result->untangled},
+          {"fold_free_reverted", node_result->fold_free_reverted},
           {"keep_nodes_apart", keep_apart},
           {"crowded_nodes", node_result->crowded_nodes},
           {"separated_nodes", node_result->separated_nodes}};

@@ -1,14 +1,12 @@
 #include "core/layout/arc_router.h"
 
-#include "core/base/errors.h"
-
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <queue>
 #include <unordered_map>
+
+#include "core/base/errors.h"
 
 namespace qs {
 
@@ -236,8 +234,7 @@ void straighten(WorkingMesh& w, const std::vector<int>& path, const std::vector<
     for (size_t k : positions) {
       const int m = path[k], a = path[k - 1], b = path[k + 1];
       const SurfacePoint o = w.origin(m);
-      const Vec3 xm = w.mesh().point(VH(m)), xa = w.mesh().point(VH(a)),
-                 xb = w.mesh().point(VH(b));
+      const Vec3 xm = w.mesh().point(VH(m)), xa = w.mesh().point(VH(a)), xb = w.mesh().point(VH(b));
       SurfacePoint target;
       target.face = o.face;
       if (w.carrier(m) == WorkingMesh::Carrier::kInputFace) {
@@ -453,11 +450,6 @@ std::vector<int> route_straight(WorkingMesh& mesh, LayoutOccupancy& occupancy, i
       if (splits) ++*splits;
       if (split_log) split_log->push_back({a, b, next});
       occupancy.sync();
-      if (getenv("QS_DBG3")) {
-        double mn = 180;
-        for (auto f : m.vf_range(VH(next))) mn = std::min(mn, mesh.face_min_angle_deg(f.idx()));
-        if (mn < 0.3) fprintf(stderr, "  straight split t %.3f (t_leave %.4f) of %d-%d: min angle %.4f, c %d\n", t, t_leave, a, b, mn, c);
-      }
     }
     mark(next);
     path.push_back(next);

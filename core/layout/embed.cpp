@@ -245,7 +245,6 @@ EmbeddedLayout embed_layout(std::shared_ptr<const TriMesh> input, const Layout& 
   if (!problems.empty()) throw InvalidInputError(list_problems(problems));
 
   // 4. Angles, then room.
-  const TriMesh& m = w.mesh();
   result.stats.flips = w.improve({}, [&](int e) { return occ.arc_on_edge(e) >= 0; });
   result.stats.separation_splits = separate_layout(w, layout);
 

@@ -583,10 +583,9 @@ WorkingMesh::Inserted WorkingMesh::insert_point(const SurfacePoint& p_in,
     const bool forward = mesh_.halfedge_handle(EH(edge), 0) == h;
     if (may_split && !may_split(edge)) {
       if (loc.bary[k] == 0) {
-        throw InvalidInputError("insert_point: the point " + bary_text(p.bary) +
-                                " of input face " + std::to_string(p.face) +
-                                " lies on working-mesh edge " + std::to_string(edge) +
-                                ", which may not be split");
+        throw InvalidInputError("insert_point: the point " + bary_text(p.bary) + " of input face " +
+                                std::to_string(p.face) + " lies on working-mesh edge " +
+                                std::to_string(edge) + ", which may not be split");
       }
       continue;
     }
@@ -632,12 +631,19 @@ WorkingMesh::Inserted WorkingMesh::insert_point(const SurfacePoint& p_in,
     if (!best || cand.min_angle > best->min_angle) best = &cand;
   }
   // No candidate meets the bar (p close to a vertex that may not be reused or an edge that may
-  // not be split): p is moved towards the centre of f until its 1→3 split does.
+  // not be split): p is moved towards the centre of f, by at most eps, until its split does.
   // On an edge of f, p moves along that edge towards its middle instead.
   Candidate moved;
   const int zeros = zero_count(loc.bary);
+  // The move is linear in s (s = 1 reaches the centre); it stops at eps from p.
+  Vec3 centre(0, 0, 0);
+  for (int k = 0; k < 3; ++k)
+    if (loc.bary[k] != 0) centre += cx[k] / (3 - zeros);
+  const double reach = (centre - x).norm();
+  const double s_max = reach > 0 ? eps / reach : 0;
   for (double s : {0.25, 0.5, 0.75}) {
-    if (chosen || zeros > 1) break;
+    if (chosen || zeros > 1 || s_max <= 0) break;
+    s = std::min(s, s_max);
     Bary b;
     for (int k = 0; k < 3; ++k)
       b[k] = loc.bary[k] == 0 ? 0.0 : (1 - s) * loc.bary[k] + s / (3 - zeros);
@@ -657,6 +663,7 @@ WorkingMesh::Inserted WorkingMesh::insert_point(const SurfacePoint& p_in,
     moved.exact = false;
     if (evaluate(moved) && moved.min_angle >= std::min(options_.min_angle_deg, moved.old_angle))
       chosen = &moved;
+    if (s >= s_max) break;
   }
   if (!chosen) chosen = best;
   if (!chosen) {

@@ -145,8 +145,9 @@ class WorkingMesh {
   //! >= min(min_angle_deg, smallest angle of the faces it splits) is taken. When no candidate
   //! meets that bar (p close to a vertex that may not be reused or an edge that may not be
   //! split, or on an edge near its end), p is moved a quarter, a half, then three quarters of the
-  //! way towards the centre of f (of its edge, when p lies on one of f's edges) and the first of
-  //! those splits that meets the bar is taken (not exact); failing that, the valid split with the
+  //! way towards the centre of f (of its edge, when p lies on one of f's edges), never further
+  //! than the snap distance ε, and the first of those splits that meets the bar is taken (not
+  //! exact); failing that, the valid split with the
   //! largest smallest angle (inside an already bad face).
   //! Edges for which \p may_split (when given) returns false are never split (an arc's edges):
   //! p then gets a face split even when it is within ε of such an edge.

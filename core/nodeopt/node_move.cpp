@@ -2,9 +2,6 @@
 
 #include <algorithm>
 #include <functional>
-#include <cstdio>
-#include <cstdlib>
-#include <cstdio>
 
 #include "core/base/errors.h"
 #include "core/layout/separation.h"
@@ -180,24 +177,23 @@ NodeMove move_node(MeshLayout& state, LayoutOccupancy& occ, const NodeArcs& arcs
                    -1);
     bool intact = true;
     // The vertices from x (excluded) to y (included) along the old edge (x, y).
-    std::function<void(int, int, std::vector<int>&, int)> expand = [&](int x, int y,
-                                                                      std::vector<int>& out,
-                                                                      int depth) {
-      if (w.mesh().find_halfedge(VH(x), VH(y)).is_valid()) {
-        out.push_back(y);
-        return;
-      }
-      int m = -1;
-      for (const auto& [a, b, mid] : splits)
-        if ((a == x && b == y) || (a == y && b == x)) m = mid;
-      if (m < 0 || depth > 64) {
-        intact = false;
-        out.push_back(y);
-        return;
-      }
-      expand(x, m, out, depth + 1);
-      expand(m, y, out, depth + 1);
-    };
+    std::function<void(int, int, std::vector<int>&, int)> expand =
+        [&](int x, int y, std::vector<int>& out, int depth) {
+          if (w.mesh().find_halfedge(VH(x), VH(y)).is_valid()) {
+            out.push_back(y);
+            return;
+          }
+          int m = -1;
+          for (const auto& [a, b, mid] : splits)
+            if ((a == x && b == y) || (a == y && b == x)) m = mid;
+          if (m < 0 || depth > 64) {
+            intact = false;
+            out.push_back(y);
+            return;
+          }
+          expand(x, m, out, depth + 1);
+          expand(m, y, out, depth + 1);
+        };
     for (size_t k = 0; k < plans.size(); ++k) {
       std::vector<int> path{old_paths[k].front()};
       for (size_t j = 1; j < old_paths[k].size(); ++j)
@@ -231,13 +227,6 @@ NodeMove move_node(MeshLayout& state, LayoutOccupancy& occ, const NodeArcs& arcs
     plan.route = route_straight(w, occ, u, request.target, 0.15, nullptr, &splits);
     if (plan.route.empty()) plan.route = route_arc(w, occ, request, nullptr, &splits);
     if (plan.route.empty()) {
-      if (getenv("QS_DBG")) {
-        fprintf(stderr, "node %d: route %zu failed: u %d old %d target %d (splice %zu of %zu); u ring:", n, k, u, old_v, request.target, plan.splice, plan.from_node.size());
-        for (auto x : w.mesh().vv_range(VH(u))) fprintf(stderr, " %d(n%d,a%d)", x.idx(), occ.node_at(x.idx()), occ.arc_at(x.idx()));
-        fprintf(stderr, "\n  edges:");
-        for (auto h : w.mesh().voh_range(VH(u))) { auto nx = w.mesh().next_halfedge_handle(h); fprintf(stderr, " opp(%d-%d):a%d", w.mesh().from_vertex_handle(nx).idx(), w.mesh().to_vertex_handle(nx).idx(), occ.arc_on_edge(w.mesh().edge_handle(nx).idx())); }
-        fprintf(stderr, "\n");
-      }
       return revert(k) ? NodeMove::kRefused : NodeMove::kBroken;
     }
     occ.set_path(plan.route, plan.arc);
@@ -261,10 +250,9 @@ NodeMove move_node(MeshLayout& state, LayoutOccupancy& occ, const NodeArcs& arcs
   // The cyclic order of arcs must stay at this node and at nodes whose arc was re-routed whole.
   bool same = same_cycle(before, encode(arcs_around(w.mesh(), layout, u, incident)));
   for (const auto& [far, order] : far_before)
-    same = same && same_cycle(order, encode(arcs_around(w.mesh(), layout,
-                                                        layout.nodes[far].vertex, arcs.arcs[far])));
+    same = same && same_cycle(order, encode(arcs_around(w.mesh(), layout, layout.nodes[far].vertex,
+                                                        arcs.arcs[far])));
   if (!same) {
-    if (getenv("QS_DBG")) fprintf(stderr, "node %d: order changed\n", n);
     for (const Plan& plan : plans) {
       occ.set_path(layout.arcs[plan.arc].path, -1);
       occ.set_path(plan.route, plan.arc);
@@ -309,18 +297,6 @@ int tidy_mesh_layout(MeshLayout& state, const std::vector<int>& candidates) {
       }
       removed += now;
       if (now == 0) break;
-    }
-    if (getenv("QS_DBG5")) {
-      int free_face = 0, free_edge = 0, failed_face = 0, failed_edge = 0;
-      std::vector<char> cand(w.mesh().n_vertices(), 0);
-      for (int v : list) if (v >= 0 && v < nv) cand[v] = 1;
-      for (int v = w.input_vertices(); v < nv; ++v) {
-        if (w.mesh().status(VH(v)).deleted() || occ.occupied(v)) continue;
-        const bool edge = w.carrier(v) == WorkingMesh::Carrier::kInputEdge;
-        (edge ? free_edge : free_face)++;
-        if (cand[v]) (edge ? failed_edge : failed_face)++;
-      }
-      fprintf(stderr, "tidy: removed %d; free refinement vertices left: %d in faces, %d on edges; of the candidates %d / %d\n", removed, free_face, free_edge, failed_face, failed_edge);
     }
   }
   // Angles repaired inside input faces (never an arc edge), then room between the arcs.

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <exception>
 #include <future>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
@@ -219,6 +220,10 @@ struct NodeOptimizer::Impl {
   int fewest_folds_count = 0;
   // The start (NodeOptOptions::initial_fallback): the last fallback of the fold-over removal.
   std::unique_ptr<State> initial_state;
+  // The fold-free accepted states with the lowest E (the initial state included), by E: the
+  // candidates of the result rule in finish(). At most kFoldFreeKept.
+  static constexpr size_t kFoldFreeKept = 4;
+  std::vector<std::pair<double, std::shared_ptr<const State>>> fold_free;
   int phase_halvings = 0;
   int stalled_steps = 0;      // accepted steps in a row with a gain below stall_gain
   double accepted_alpha = 0;  // α of the phase's last accepted descent step (0: none yet)
@@ -283,6 +288,7 @@ struct NodeOptimizer::Impl {
       options.param.vertex_order = current.pipeline->options().param.vertex_order;
     }
     fewest_folds_count = current.foldovers;
+    note_fold_free();
     result.E_init = current.E;
     result.foldovers_init = current.foldovers;
     StepReport r;
@@ -482,6 +488,17 @@ struct NodeOptimizer::Impl {
     solve_and_measure(ev, options);
     counters.prepared_param_solvers += ev.pipeline->param_solver_prepared();
     return ev;
+  }
+
+  // The current (just accepted) state, when it has no fold-over and is among the
+  // kFoldFreeKept lowest E of the fold-free states so far: a candidate for the result rule.
+  void note_fold_free() {
+    if (current.foldovers > 0) return;
+    if (fold_free.size() >= kFoldFreeKept && current.E >= fold_free.back().first) return;
+    auto at = std::upper_bound(fold_free.begin(), fold_free.end(), current.E,
+                               [](double e, const auto& c) { return e < c.first; });
+    fold_free.insert(at, {current.E, std::make_shared<const State>(state)});
+    if (fold_free.size() > kFoldFreeKept) fold_free.pop_back();
   }
 
   void note_fold_count(const State& before, int after_folds) {
@@ -702,6 +719,7 @@ struct NodeOptimizer::Impl {
         note_fold_count(state, next.foldovers);
         state = std::move(hopped);
         current = std::move(next);
+        note_fold_free();
         current_solved = true;
         state_changed = true;
         result.hops += h.moved;
@@ -1016,6 +1034,7 @@ struct NodeOptimizer::Impl {
       note_fold_count(state, next.foldovers);
       state = std::move(trial);
       current = std::move(next);
+      note_fold_free();
       current_solved = true;
       state_changed = true;
       ++result.accepted;
@@ -1340,6 +1359,51 @@ struct NodeOptimizer::Impl {
             std::string(result.orientation.message.empty() ? "" : "; ") + "untangling: " + e.what();
       }
       emit_orientation(state, result, result.untangled, t_un, result.reports, observer);
+    }
+    // The rule for the result: the lowest E among the fold-free, structurally equivalent states,
+    // and never worse than a fold-free state visited (the input included). The fold-over
+    // removal above can end higher than a fold-free state the descent passed through (the
+    // orientation constraints of a folded final state cost E, or its fallbacks are older).
+    // Ranks: fold-free and structurally equivalent (2), fold-free (1), folded (0); within a
+    // rank the lower E. The kept fold-free states are solved afresh from the lowest E up.
+    const auto rank = [](int folds, bool equivalent) { return folds > 0 ? 0 : equivalent ? 2 : 1; };
+    int result_rank = rank(result.face_weights.empty() ? result.foldovers_final : 1,
+                           result.pipeline && result.pipeline->extract().structurally_equivalent);
+    std::shared_ptr<const State> taken;
+    Evaluation taken_ev;
+    for (const auto& [E, candidate] : fold_free) {
+      if (result_rank == 2 && E >= result.E_final) break;
+      if (same_state(*candidate, state)) continue;
+      check_cancel(observer);
+      Evaluation ev = evaluate_fresh(candidate->mesh, candidate->layout, options, false);
+      ++counters.fresh_pipelines;
+      const int r = rank(ev.foldovers, ev.pipeline->extract().structurally_equivalent);
+      const double best_E = taken ? taken_ev.E : result.E_final;
+      if (r > result_rank || (r == result_rank && r > 0 && ev.E < best_E)) {
+        taken = candidate;
+        taken_ev = std::move(ev);
+        result_rank = r;
+      }
+      if (result_rank == 2) break;  // the lowest E of the rank-2 states kept
+    }
+    if (taken) {
+      result.initial_reverted = initial_state && same_state(*initial_state, *taken);
+      state = *taken;
+      result.pipeline = taken_ev.pipeline;
+      result.descent_pipeline = taken_ev.pipeline;
+      result.E_final = taken_ev.E;
+      result.foldovers_final = 0;
+      result.orientation_constraints = false;
+      result.orientation_options = OrientationOptions{};
+      result.face_weights.clear();
+      result.untangled = false;
+      result.fold_free_reverted = true;
+      StepReport r;
+      r.step = result.steps + result.hop_rounds + 1;
+      r.E = taken_ev.E;
+      r.accepted = true;
+      r.phase = "fold-free";
+      emit_step(r, state.mesh, state.layout, result.reports, observer);
     }
     if (stats) *stats = counters;
     result.mesh = std::move(state.mesh);

@@ -275,6 +275,11 @@ struct NodeOptResult {
   //! untangle), the last resort after the orientation constraints at every state tried and
   //! stiffening left some.
   bool untangled = false;
+  //! The state returned is the fold-free state with the lowest E that the descent accepted (the
+  //! initial state included): the fold-over removal of the later states ended higher, folded, or
+  //! not structurally equivalent. The rule: the lowest E among the fold-free, structurally
+  //! equivalent states, never worse than a fold-free input.
+  bool fold_free_reverted = false;
   int stiffening_iterations = 0;
   //! NodeOptOptions::stop (or DiscreteOptions::stop) ended the node movement before the
   //! descent and polish (the discrete sweeps) were over.

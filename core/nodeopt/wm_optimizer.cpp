@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "core/base/errors.h"
 #include "core/base/timing.h"
@@ -27,8 +25,8 @@ struct Solved {
 void measure(Solved& s, const PipelineOptions& options) {
   s.pipeline->compute_field();
   const Parameterization& p = s.pipeline->compute_parameterization();
-  s.E = unweighted_energy(s.pipeline->mesh(), s.pipeline->geometry(), s.pipeline->field()->theta,
-                          p, options.param);
+  s.E = unweighted_energy(s.pipeline->mesh(), s.pipeline->geometry(), s.pipeline->field()->theta, p,
+                          options.param);
   s.foldovers = p.foldovers;
 }
 
@@ -51,7 +49,9 @@ std::vector<std::array<double, 3>> positions(const MeshLayout& st) {
 }  // namespace
 
 void validate_wm_options(const WmOptions& o) {
-  auto fail = [](const std::string& what) { throw InvalidInputError("node optimization: " + what); };
+  auto fail = [](const std::string& what) {
+    throw InvalidInputError("node optimization: " + what);
+  };
   if (o.max_steps < 0) fail("max_steps must be >= 0");
   if (!(std::isfinite(o.alpha) && o.alpha > 0 && o.alpha <= 10)) fail("alpha must be in (0, 10]");
   if (o.max_halvings < 0) fail("max_halvings must be >= 0");
@@ -80,7 +80,11 @@ struct WmOptimizer::Impl {
   WmResult result;
 
   Impl(MeshLayout start, const PipelineOptions& opts, const WmOptions& node_options, Observer* obs)
-      : options(opts), no(node_options), observer(obs), state(std::move(start)), initial(state),
+      : options(opts),
+        no(node_options),
+        observer(obs),
+        state(std::move(start)),
+        initial(state),
         alpha(node_options.alpha) {
     validate_wm_options(no);
     const TriMesh& in = state.mesh.input();
@@ -89,8 +93,7 @@ struct WmOptimizer::Impl {
     mean_edge = in.n_edges() > 0 ? sum / in.n_edges() : 1.0;
     patches = count_patches(state.mesh.mesh(), state.layout);
     pinned.assign(state.layout.nodes.size(), 0);
-    for (size_t n = 0; n < state.layout.nodes.size(); ++n)
-      pinned[n] = state.layout.nodes[n].pinned;
+    for (size_t n = 0; n < state.layout.nodes.size(); ++n) pinned[n] = state.layout.nodes[n].pinned;
     check_cancel(observer);
     current = solve_fresh(state, options);
     result.E_init = current.E;
@@ -174,12 +177,10 @@ struct WmOptimizer::Impl {
     std::vector<int> freed;
     int moved = 0;
     bool relaid = false, broken = false;
-    int kinds[4] = {0, 0, 0, 0};
     const int faces_before = static_cast<int>(trial.mesh.mesh().n_faces());
     for (size_t i = 0; i < nodes.size(); ++i) {
       const double g = grad[i].norm();
       double len = alpha * scale * g;
-      if (const char* cap = getenv("QS_CAP")) len = std::min(len, std::atof(cap) * mean_edge);
       if (!(len >= 1e-4 * mean_edge)) continue;
       const int n = nodes[i];
       // Traced on the state's working mesh (the same surface as the input), inside the cell.
@@ -197,36 +198,14 @@ struct WmOptimizer::Impl {
       if (tr.truncated || bary[0] == 0 || bary[1] == 0 || bary[2] == 0)
         for (double& b : bary) b = 0.98 * b + 0.02 / 3;
       const SurfacePoint target = state.mesh.input_point(tr.end.face, bary);
-      const double before_angle = getenv("QS_DBG2") ? trial.mesh.min_angle_deg() : 0;
-      if (getenv("QS_DBG4")) {
-        const int v0 = trial.layout.nodes[n].vertex;
-        if (!trial.mesh.is_input_vertex(v0)) {
-          const SurfacePoint o = trial.mesh.origin(v0);
-          fprintf(stderr, "  node %d: carrier %d, same face %d, can move %d, step %.3g edges\n", n,
-                  int(trial.mesh.carrier(v0)), int(o.face == target.face),
-                  int(trial.mesh.can_move_vertex(v0, target)), len / mean_edge);
-        }
-      }
       const NodeMove kind = move_node(trial, occ, arcs, n, target, freed);
-      if (getenv("QS_DBG2")) {
-        const double after = trial.mesh.min_angle_deg();
-        if (after < 0.5 && after < before_angle)
-          fprintf(stderr, "node %d: kind %d min angle %.4f -> %.4f\n", n, int(kind), before_angle, after);
-      }
       if (kind == NodeMove::kBroken) {
         broken = true;
         break;
       }
       moved += kind != NodeMove::kRefused;
       relaid = relaid || kind == NodeMove::kRelaid;
-      kinds[int(kind)]++;
-      if (kind == NodeMove::kRelaid && getenv("QS_DBG4")) {
-        const int v0 = state.layout.nodes[n].vertex;
-        fprintf(stderr, "  node %d relaid: carrier %d, input vertex %d, step %.3g edges\n", n,
-                int(state.mesh.carrier(v0)), int(state.mesh.is_input_vertex(v0)), len / mean_edge);
-      }
     }
-    if (getenv("QS_DBG")) fprintf(stderr, "kinds: refused %d geometry %d relaid %d\n", kinds[0], kinds[1], kinds[2]);
     relaid = relaid || static_cast<int>(trial.mesh.mesh().n_faces()) != faces_before;
     ++result.steps;
     StepReport r;
@@ -246,10 +225,11 @@ struct WmOptimizer::Impl {
     bool ok = !broken;
     try {
       if (broken) {
+        // a node could not be moved without breaking the layout: the step is refused
       } else if (relaid) {
         // Free refinement vertices around the moved nodes go too (separation puts back the
         // ones the arcs need): the mesh does not keep refining where nodes pass.
-        if (!getenv("QS_NOWIDE")) {
+        {
           const TriMesh& tm = trial.mesh.mesh();
           for (int n : nodes) {
             const int v = trial.layout.nodes[n].vertex;
@@ -261,7 +241,6 @@ struct WmOptimizer::Impl {
         }
         tidy_mesh_layout(trial, freed);
         ok = count_patches(trial.mesh.mesh(), trial.layout) == patches;
-        if (getenv("QS_DBG")) fprintf(stderr, "patches %d vs %d\n", count_patches(trial.mesh.mesh(), trial.layout), patches);
         if (ok) next = solve_fresh(trial, options);
       } else {
         next.pipeline = current.pipeline;
@@ -270,8 +249,7 @@ struct WmOptimizer::Impl {
       }
     } catch (const Cancelled&) {
       throw;
-    } catch (const InvalidInputError& e) {
-      if (getenv("QS_DBG")) fprintf(stderr, "invalid: %s\n", e.what());
+    } catch (const InvalidInputError&) {
       ok = false;  // a layout the field cannot realize: like an increase
     } catch (const SolverError&) {
       ok = false;
@@ -279,44 +257,6 @@ struct WmOptimizer::Impl {
     r.accepted = ok && next.E <= current.E;
     r.E = ok ? next.E : current.E;
     r.foldovers = ok ? next.foldovers : current.foldovers;
-    if (getenv("QS_DBG") && ok) {
-      // Where the fold-overs are: face distance (rings) to the nearest node vertex.
-      const TriMesh& tm = trial.mesh.mesh();
-      std::vector<int> src;
-      for (const auto& nd : trial.layout.nodes) src.push_back(nd.vertex);
-      const auto& uv = next.pipeline->parameterization()->corner_uv;
-      std::vector<int> hist(8, 0);
-      std::vector<int> dist(tm.n_vertices(), -1);
-      std::vector<int> q;
-      for (int v : src) dist[v] = 0, q.push_back(v);
-      for (size_t qi = 0; qi < q.size(); ++qi)
-        for (auto x : tm.vv_range(tm.vertex_handle(q[qi])))
-          if (dist[x.idx()] < 0) dist[x.idx()] = dist[q[qi]] + 1, q.push_back(x.idx());
-      for (auto f : tm.faces()) {
-        const auto& a = uv[3 * f.idx()]; const auto& b = uv[3 * f.idx() + 1]; const auto& c = uv[3 * f.idx() + 2];
-        if ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) > 0) continue;
-        int d = 99;
-        for (auto v : tm.fv_range(f)) d = std::min(d, dist[v.idx()]);
-        hist[std::min(d, 7)]++;
-      }
-      {
-        std::vector<double> ratio, angle;
-        double mean_area = 0;
-        for (auto f : tm.faces()) mean_area += tm.calc_face_area(f);
-        mean_area /= tm.n_faces();
-        for (auto f : tm.faces()) {
-          const auto& a = uv[3 * f.idx()]; const auto& b = uv[3 * f.idx() + 1]; const auto& c = uv[3 * f.idx() + 2];
-          if ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) > 0) continue;
-          ratio.push_back(tm.calc_face_area(f) / mean_area);
-          angle.push_back(trial.mesh.face_min_angle_deg(f.idx()));
-        }
-        std::sort(ratio.begin(), ratio.end()); std::sort(angle.begin(), angle.end());
-        if (!ratio.empty()) fprintf(stderr, "folded faces: area/mean quartiles %.3g %.3g %.3g, min angle quartiles %.3g %.3g %.3g\n", ratio[ratio.size()/4], ratio[ratio.size()/2], ratio[3*ratio.size()/4], angle[angle.size()/4], angle[angle.size()/2], angle[3*angle.size()/4]);
-      }
-      fprintf(stderr, "folds by ring distance to a node:");
-      for (int h : hist) fprintf(stderr, " %d", h);
-      fprintf(stderr, "; min angle %.3f deg, faces %zu\n", trial.mesh.min_angle_deg(), tm.n_faces());
-    }
     if (r.accepted) {
       state = std::move(trial);
       current = std::move(next);
