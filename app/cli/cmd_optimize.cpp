@@ -109,10 +109,11 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     auto t0 = t_total;
     MeshReport mesh_report;
     set_activity("loading the mesh '" + o.mesh + "'");
-    TriMesh mesh = load_mesh(o.mesh, &mesh_report);
-    set_activity("loading the layout '" + o.layout + "'");
-    Layout layout = load_layout(o.layout, mesh);
+    SurfaceLayout on_surface = load_command_layout(o.layout, load_mesh(o.mesh, &mesh_report));
     report["mesh"] = mesh_json(mesh_report);
+    report["working_mesh"] = working_mesh_json(on_surface);
+    TriMesh mesh = std::move(on_surface.mesh);
+    Layout layout = std::move(on_surface.layout);
     // A parameterization close to isometric has about the surface's area: refuse an absurd
     // quad size now rather than after the whole optimization.
     if (o.quad_size > 0) {

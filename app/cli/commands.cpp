@@ -19,10 +19,11 @@ int run_validate(const ValidateOptions& o, const CommonOptions& common) {
   if (!o.out.empty()) require_writable_folder(o.out);
   set_activity("loading the mesh '" + o.mesh + "'");
   MeshReport report;
-  const TriMesh mesh = load_mesh(o.mesh, &report);
+  const TriMesh input = load_mesh(o.mesh, &report);
   for (const auto& w : report.warnings) std::cerr << "warning: " << o.mesh << ": " << w << "\n";
-  set_activity("loading the layout '" + o.layout + "'");
-  const Layout layout = load_layout(o.layout, mesh);
+  const SurfaceLayout on_surface = load_command_layout(o.layout, input);
+  const TriMesh& mesh = on_surface.mesh;
+  const Layout& layout = on_surface.layout;
   set_activity("validating the layout '" + o.layout + "'");
   const ValidationResult result = validate_layout(mesh, layout);
   set_activity("reporting the issues of the layout '" + o.layout + "'");
@@ -31,6 +32,7 @@ int run_validate(const ValidateOptions& o, const CommonOptions& common) {
 
   nlohmann::json out = {{"status", result.valid() ? "ok" : "invalid"},
                         {"mesh", mesh_json(report)},
+                        {"working_mesh", working_mesh_json(on_surface)},
                         {"errors", result.errors()},
                         {"warnings", result.warnings()}};
   nlohmann::json issues = nlohmann::json::array();
@@ -77,10 +79,11 @@ int run_field(const FieldOptions& o, const CommonOptions& common) {
     auto t0 = t_total;
     MeshReport mesh_report;
     set_activity("loading the mesh '" + o.mesh + "'");
-    TriMesh mesh = load_mesh(o.mesh, &mesh_report);
-    set_activity("loading the layout '" + o.layout + "'");
-    Layout layout = load_layout(o.layout, mesh);
+    SurfaceLayout on_surface = load_command_layout(o.layout, load_mesh(o.mesh, &mesh_report));
     report["mesh"] = mesh_json(mesh_report);
+    report["working_mesh"] = working_mesh_json(on_surface);
+    TriMesh mesh = std::move(on_surface.mesh);
+    Layout layout = std::move(on_surface.layout);
     const double load_s = seconds_since(t0);
     PipelineOptions options;
     options.field.constraints.sharp_angle_deg = o.sharp_angle_deg;

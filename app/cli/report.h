@@ -15,6 +15,7 @@
 #include "core/base/timing.h"
 #include "core/field/cross_field.h"
 #include "core/layout/layout.h"
+#include "core/layout/layout_input.h"
 #include "core/mesh/mesh_io.h"
 
 namespace qs::cli {
@@ -34,6 +35,30 @@ inline nlohmann::json mesh_json(const MeshReport& r) {
           {"faces", r.faces},
           {"genus", r.genus},
           {"boundaries", r.boundary_loops}};
+}
+
+//! The mesh the pipeline ran on: the input mesh, or a working mesh refined from it to carry
+//! the layout (load_layout_on_surface), with its size relative to the input.
+inline nlohmann::json working_mesh_json(const SurfaceLayout& s) {
+  nlohmann::json j = {
+      {"refined", s.on_working_mesh},
+      {"vertices", s.mesh.n_vertices()},
+      {"faces", s.mesh.n_faces()},
+      {"growth", s.input_faces > 0 ? double(s.mesh.n_faces()) / s.input_faces : 1.0}};
+  if (s.on_working_mesh) {
+    j["inserted_nodes"] = s.embed.inserted_nodes;
+    j["snapped_nodes"] = s.embed.snapped_nodes;
+    j["route_splits"] = s.embed.route_splits;
+    j["separation_splits"] = s.embed.separation_splits;
+    j["flips"] = s.embed.flips;
+  }
+  return j;
+}
+
+//! Loads the layout of a command for \p input (load_layout_on_surface), announcing it.
+inline SurfaceLayout load_command_layout(const std::string& path, const TriMesh& input) {
+  set_activity("loading the layout '" + path + "'");
+  return load_layout_on_surface(path, input);
 }
 
 inline nlohmann::json layout_json(const LayoutTopology& topo) {

@@ -528,8 +528,8 @@ Layout parse_layout_json(const std::string& text, const std::string& source_name
   return LayoutReader(source_name).read(doc);
 }
 
-Layout load_layout(const std::string& path, const TriMesh& mesh) {
-  Layout layout = parse_layout_json(read_input_file(path, kMaxLayoutFileBytes), path);
+void check_layout_on_mesh(const std::string& path, Layout& layout, const TriMesh& mesh,
+                          bool snap_points) {
   const int nv = static_cast<int>(mesh.n_vertices());
   const int nf = static_cast<int>(mesh.n_faces());
   if (layout.mesh_vertices >= 0 && (layout.mesh_vertices != nv || layout.mesh_faces != nf)) {
@@ -551,7 +551,7 @@ Layout load_layout(const std::string& path, const TriMesh& mesh) {
       if (!problem.empty()) {
         problems.push_back(who + ": point: " + problem);
       } else if (node.vertex < 0) {
-        node.vertex = snap_to_vertex(mesh, *node.point);
+        if (snap_points) node.vertex = snap_to_vertex(mesh, *node.point);
       } else if (node.vertex < nv) {
         // Both given (as written for snapped and output nodes): they must name the same vertex,
         // else one of them would be ignored silently.
@@ -584,7 +584,15 @@ Layout load_layout(const std::string& path, const TriMesh& mesh) {
     for (size_t k = 0; k < problems.size(); ++k) msg += (k ? "; " : "") + problems[k];
     throw InvalidInputError(msg);
   }
+}
 
+Layout read_layout_file(const std::string& path) {
+  return parse_layout_json(read_input_file(path, kMaxLayoutFileBytes), path);
+}
+
+Layout load_layout(const std::string& path, const TriMesh& mesh) {
+  Layout layout = read_layout_file(path);
+  check_layout_on_mesh(path, layout, mesh, /*snap_points=*/true);
   try {
     route_layout(mesh, layout);
   } catch (const InvalidInputError& e) {

@@ -35,6 +35,18 @@ constexpr std::uintmax_t kMaxLayoutFileBytes = std::uintmax_t{256} << 20;
 //! \throw InvalidInputError as above.
 Layout parse_layout_json(const std::string& text, const std::string& source_name = "<layout>");
 
+//! Reads and parses a layout file (parse_layout_json), without resolving it on a mesh.
+//! Only a regular file of at most kMaxLayoutFileBytes is read (read_input_file).
+//! \throw InvalidInputError (message starts with \p path) as load_layout.
+Layout read_layout_file(const std::string& path);
+
+//! The checks of load_layout on \p mesh: the "mesh" block, node vertices in range, every surface
+//! point (node points, arc points, samples), and a node's vertex and point that disagree. With
+//! \p snap_points, a node with only a point gets the vertex it snaps to (snap_to_vertex).
+//! \throw InvalidInputError (message starts with \p path) listing every problem with its id.
+void check_layout_on_mesh(const std::string& path, Layout& layout, const TriMesh& mesh,
+                          bool snap_points);
+
 //! Reads a layout file and resolves it on \p mesh: checks the optional "mesh" block (vertex
 //! and face counts must match), node vertices (in range), every surface point (node points,
 //! arc points and samples: face in range, finite barycentrics >= -1e-9 summing to 1 within
