@@ -193,6 +193,13 @@ bool Automation::run_command(const Command& c, AppContext& ctx, const glm::ivec2
                               latest->status == WorkerStatus::Failed));
   }
   if (n == "wait_camera") return wait(c, !ctx.camera.animating(), 30.0);
+  if (n == "wait_guides") {
+    const bool plane =
+        !editor.symmetry.enabled() || editor.mirror() || !editor.symmetry.error().empty();
+    const bool hints = !editor.field_hints.enabled || editor.field_hints.field() ||
+                       !editor.field_hints.error().empty();
+    return wait(c, plane && hints);
+  }
   if (n == "wait_status") {
     const SnapshotPtr& latest = editor.job.latest();
     return wait(c, latest && !a.empty() && a[0] == to_string(latest->status));
@@ -231,6 +238,23 @@ bool Automation::run_command(const Command& c, AppContext& ctx, const glm::ivec2
       fail(c, "unknown tool");
     else
       ctx.tools.set_tool(tool);
+  } else if (n == "symmetry") {
+    if (a.empty()) {
+      fail(c, "expected: symmetry off|x|y|z|auto");
+    } else if (a[0] == "off") {
+      editor.symmetry.disable();
+    } else {
+      try {
+        editor.symmetry.enable(parse_symmetry_axis(a[0]));
+      } catch (const std::exception& e) {
+        fail(c, e.what());
+      }
+    }
+  } else if (n == "field_hints") {
+    if (a.empty() || (a[0] != "on" && a[0] != "off"))
+      fail(c, "expected: field_hints on|off");
+    else
+      editor.field_hints.enabled = a[0] == "on";
   } else if (n == "click_vertex") {
     if (!arg_int(0, x)) return true;
     if (!editor.doc.mesh || x < 0 || x >= int(editor.doc.mesh->n_vertices())) {
