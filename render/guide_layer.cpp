@@ -101,12 +101,12 @@ void GuideLayer::upload(const SceneData& data) {
       std::vector<float> glyphs;
       const glm::vec4 color(GuideColors::kHintCross, hint_alpha);
       for (int f : faces) {
-        const glm::vec3 d = to_vec3(field->direction[f]) * (0.8f * arm);
+        const glm::vec3 d = to_vec3(field->direction[f]) * arm;
         if (!(glm::length(d) > 0.0f)) continue;
         const glm::vec3& c = centroid[f];
         const glm::vec3& n = normal[f];
         glyphs.insert(glyphs.end(), {c.x, c.y, c.z, d.x, d.y, d.z, n.x, n.y, n.z, color.r, color.g,
-                                     color.b, color.a, color.r, color.g, color.b, color.a, 1.2f});
+                                     color.b, color.a, color.r, color.g, color.b, color.a, 1.5f});
       }
       crosses_ = int(glyphs.size() / kGlyphFloats);
       if (crosses_ > 0) {
@@ -122,7 +122,7 @@ void GuideLayer::upload(const SceneData& data) {
         if (s.vertex < 0 || s.vertex >= int(mesh->n_vertices())) continue;
         const glm::vec3 p = to_vec3(mesh->point(OpenMesh::VertexHandle(s.vertex)));
         const glm::vec3 c = GuideColors::singularity(s.index);
-        points.insert(points.end(), {p.x, p.y, p.z, c.r, c.g, c.b, 0.55f, marker_size, 0.0f});
+        points.insert(points.end(), {p.x, p.y, p.z, c.r, c.g, c.b, 0.8f, marker_size, 3.0f});
       }
       markers_ = int(points.size() / kPointFloats);
       if (markers_ > 0) {
@@ -200,7 +200,9 @@ void GuideLayer::draw(const FrameContext& frame) {
     points_.set("u_view", frame.camera->view());
     points_.set("u_proj", frame.camera->projection());
     points_.set("u_pixel_ratio", frame.pixel_ratio);
-    points_.set("u_pull", 1.5f * pull);
+    // A flat ring at a grazing angle would be cut by the surface in front of its centre: pulled
+    // towards the eye by 2.5 % of the scene's size (far less than the depth of the far side).
+    points_.set("u_pull", 0.025f * scene_scale_);
     points_.set("u_size_scale", 1.0f);
     marker_vao_.bind();
     glDrawArrays(GL_POINTS, 0, markers_);

@@ -1,5 +1,5 @@
 // Sketching guides: the field hints (the natural cross field of the bare mesh as faint crosses,
-// and faint markers at its singularities, coloured like the nodes of the valence that belongs
+// and hollow rings at its singularities, coloured like the nodes of the valence that belongs
 // there) and the mirror plane of symmetric sketching (the curve where it cuts the surface).
 #pragma once
 
@@ -36,8 +36,8 @@ class GuideLayer : public Layer {
   bool reload(std::string* log);
 
   int max_glyphs = 6000;
-  float hint_alpha = 0.45f;   //!< of the hint crosses
-  float marker_size = 11.0f;  //!< window pixels
+  float hint_alpha = 0.6f;    //!< of the hint crosses
+  float marker_size = 18.0f;  //!< ring diameter, window pixels
   float mirror_width = 2.5f;  //!< window pixels
 
   int hint_crosses() const { return crosses_; }
