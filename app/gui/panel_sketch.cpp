@@ -30,8 +30,11 @@ void draw_symmetry(AppContext& ctx) {
       "x / y / z: the plane x, y or z = const through the centre of the mesh's bounding box. "
       "Fitted: the plane that maps the mesh onto itself best (principal axes refined by "
       "closest-point iterations); the residual says how symmetric the mesh is.");
-  if (const std::string d = symmetry.description(); !d.empty())
+  if (const std::string d = symmetry.description(); !d.empty()) {
+    ImGui::PushTextWrapPos(0.0f);  // the residual must not be cut off by the panel's edge
     text_colored(symmetry.error().empty() ? kDimColor : kErrorColor, d);
+    ImGui::PopTextWrapPos();
+  }
 }
 
 }  // namespace

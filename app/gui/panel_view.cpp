@@ -97,7 +97,7 @@ void draw_field_hints(AppContext& ctx) {
   ImGui::Checkbox("Field hints", &hints.enabled);
   tooltip(
       "The smoothest cross field of the bare mesh, following its curvature, sharp edges and "
-      "boundary with its singularities free: faint crosses, and markers where irregular nodes "
+      "boundary with its singularities free: faint crosses, and rings where irregular nodes "
       "belong (coloured like nodes: valence 3 / valence 5). Computed once per mesh in the "
       "background.");
   if (!hints.enabled) return;

@@ -1,8 +1,23 @@
 #include "app/gui/symmetry_state.h"
 
+#include <cmath>
 #include <cstdio>
 
 namespace qs::app {
+
+namespace {
+
+// \p v for display: 0 when below 1e-9 of \p scale (rounding noise), never "-0".
+double shown(double v, double scale) {
+  return std::abs(v) < 1e-9 * scale ? 0.0 : v + 0.0;
+}
+
+// A normal component rounded to the 3 decimals shown, never "-0.000".
+double component(double v) {
+  return std::round(v * 1000.0) / 1000.0 + 0.0;
+}
+
+}  // namespace
 
 void SymmetryState::enable(SymmetryAxis axis) {
   if (enabled_ && axis_ == axis) return;
@@ -59,14 +74,16 @@ std::string SymmetryState::description() const {
   if (!error_.empty()) return "no mirror plane: " + error_;
   if (!fit_) return axis_ == SymmetryAxis::Auto ? "fitting the mirror plane..." : "preparing...";
   const MirrorPlane& p = fit_->plane;
+  const double h = mirror_ ? mirror_->snap : 1.0;  // the mean edge length
   char text[160];
   if (axis_ == SymmetryAxis::Auto)
     std::snprintf(text, sizeof(text),
-                  "n = (%.3f, %.3f, %.3f), offset %.4g; residual %.2g of the diagonal", p.normal[0],
-                  p.normal[1], p.normal[2], p.offset, fit_->relative);
+                  "n = (%.3f, %.3f, %.3f), offset %.4g; residual %.2g of the diagonal",
+                  component(p.normal[0]), component(p.normal[1]), component(p.normal[2]),
+                  shown(p.offset, h), fit_->relative);
   else
     std::snprintf(text, sizeof(text), "%s = %.4g; residual %.2g of the diagonal", to_string(axis_),
-                  p.offset, fit_->relative);
+                  shown(p.offset, h), fit_->relative);
   return text;
 }
 
