@@ -8,7 +8,9 @@
 #include <utility>
 #include <vector>
 
+#include "core/field/natural_field.h"
 #include "core/layout/layout.h"
+#include "core/layout/symmetry.h"
 #include "core/mesh/mesh.h"
 #include "core/pipeline/snapshot.h"
 #include "render/camera.h"
@@ -58,6 +60,12 @@ struct SceneData {
   //! Free-hand stroke being drawn (points on the surface, drawing order); part of the
   //! interaction state (interaction_version).
   std::vector<glm::vec3> stroke_points;
+  //! Field hints: the natural cross field of the bare mesh (null: not shown).
+  const NaturalField* hints = nullptr;
+  std::uint64_t hints_version = 0;
+  //! The mirror plane of symmetric sketching (null: off).
+  const MirrorPlane* mirror = nullptr;
+  std::uint64_t mirror_version = 0;
 };
 
 //! Per-frame drawing context.

@@ -38,6 +38,7 @@ void Renderer::init(const RendererOptions& options) {
   layout_layer_ = std::make_unique<LayoutLayer>();
   field_layer_ = std::make_unique<FieldLayer>();
   field_layer_->visible = options.show_field;
+  guide_layer_ = std::make_unique<GuideLayer>();
   scene_cache_.set_enabled(options.scene_cache);
 }
 
@@ -46,6 +47,7 @@ void Renderer::shutdown() {
   mesh_layer_.reset();
   layout_layer_.reset();
   field_layer_.reset();
+  guide_layer_.reset();
   background_.reset();
   scene_cache_.release();
   ImGui_ImplOpenGL3_Shutdown();
@@ -73,6 +75,7 @@ void Renderer::reload_shaders(std::string* log) {
   mesh_layer_->reload(log);
   layout_layer_->reload(log);
   field_layer_->reload(log);
+  guide_layer_->reload(log);
   scene_cache_.invalidate();  // the cached image was drawn with the old shaders
 }
 
@@ -116,7 +119,10 @@ bool Renderer::draw_scene(const SceneData& scene, const Camera& camera,
   frame.framebuffer = framebuffer;
   frame.pixel_ratio = float(framebuffer.x) / std::max(1.0f, camera.viewport().x);
   frame.time_s = time_s;
-  Layer* const layers[] = {mesh_layer_.get(), field_layer_.get(), layout_layer_.get()};
+  Layer* const layers[] = {mesh_layer_.get(), field_layer_.get(), guide_layer_.get(),
+                           layout_layer_.get()};
+  // The profile stage each layer's drawing counts to (the guides with the field).
+  const int stages[] = {kStageSurface, kStageField, kStageField, kStageLayout};
   // Uploads happen only when a version changed (a new snapshot, an edit).
   for (Layer* layer : layers) layer->upload(scene);
   profile_mark(kStageUpload);
@@ -168,9 +174,9 @@ bool Renderer::draw_scene(const SceneData& scene, const Camera& camera,
     glEnable(GL_MULTISAMPLE);
     background_->draw();
     profile_mark(kStageClear);
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < 4; ++i) {
       layers[i]->draw(frame);
-      profile_mark(kStageSurface + i);
+      profile_mark(stages[i]);
     }
     if (!direct) scene_cache_.end();
   }

@@ -10,6 +10,7 @@
 #include "render/background.h"
 #include "render/camera.h"
 #include "render/field_layer.h"
+#include "render/guide_layer.h"
 #include "render/layers.h"
 #include "render/layout_layer.h"
 #include "render/mesh_layer.h"
@@ -87,6 +88,7 @@ class Renderer {
   MeshLayer& mesh_layer() { return *mesh_layer_; }
   LayoutLayer& layout_layer() { return *layout_layer_; }
   FieldLayer& field_layer() { return *field_layer_; }
+  GuideLayer& guide_layer() { return *guide_layer_; }
   const FieldLayer* field_layer_if() const { return field_layer_.get(); }
   SceneCache& cache() { return scene_cache_; }
   const RendererOptions& options() const { return options_; }
@@ -98,6 +100,7 @@ class Renderer {
   std::unique_ptr<MeshLayer> mesh_layer_;
   std::unique_ptr<LayoutLayer> layout_layer_;
   std::unique_ptr<FieldLayer> field_layer_;
+  std::unique_ptr<GuideLayer> guide_layer_;
   SceneCache scene_cache_;
   std::uint64_t last_camera_key_ = 0;
   double profile_ms_[kProfileStages] = {};

@@ -48,6 +48,10 @@ void add_scene(FrameKey& key, const SceneData& scene) {
   key.add(reinterpret_cast<std::uintptr_t>(scene.field));
   key.add(scene.field_version);
   key.add(scene.stroke_points);
+  key.add(reinterpret_cast<std::uintptr_t>(scene.hints));
+  key.add(scene.hints_version);
+  key.add(reinterpret_cast<std::uintptr_t>(scene.mirror));
+  key.add(scene.mirror_version);
 }
 
 SceneCache::~SceneCache() {

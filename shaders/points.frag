@@ -8,6 +8,12 @@ void main() {
   float r2 = dot(p, p);
   if (r2 > 1.0) discard;
   vec3 color = v_color.rgb;
+  // Hint marker: a flat hollow ring (not a node).
+  if (v_ring > 2.5) {
+    if (r2 < 0.42) discard;
+    frag_color = vec4(color, v_color.a * clamp((1.0 - sqrt(r2)) * 8.0, 0.0, 1.0));
+    return;
+  }
   // Pinned: dark outer ring with a gold band; selected: bright yellow ring.
   if (v_ring > 1.5 && r2 > 0.55) {
     color = vec3(1.0, 0.86, 0.15);

@@ -3,7 +3,7 @@
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec4 a_color;
 layout(location = 2) in float a_size;   // diameter, window pixels
-layout(location = 3) in float a_ring;   // 0 none, 1 pinned marker, 2 selected
+layout(location = 3) in float a_ring;   // 0 none, 1 pinned marker, 2 selected, 3 hollow ring
 
 uniform mat4 u_view;
 uniform mat4 u_proj;

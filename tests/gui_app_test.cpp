@@ -7,9 +7,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -41,6 +46,35 @@ json arc_by_id(const json& layout, int id) {
   for (const auto& a : layout.at("arcs"))
     if (a.at("id") == id) return a;
   return nullptr;
+}
+
+// The vertex positions of an OBJ file (its "v" lines).
+std::vector<std::array<double, 3>> obj_vertices(const fs::path& path) {
+  std::vector<std::array<double, 3>> out;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream ls(line);
+    std::string tag;
+    std::array<double, 3> p{};
+    if (ls >> tag && tag == "v" && ls >> p[0] >> p[1] >> p[2]) out.push_back(p);
+  }
+  return out;
+}
+
+// The vertex of \p vertices nearest to \p p.
+int nearest_vertex(const std::vector<std::array<double, 3>>& vertices, std::array<double, 3> p) {
+  int best = -1;
+  double best_d = 1e300;
+  for (int v = 0; v < int(vertices.size()); ++v) {
+    double d = 0;
+    for (int k = 0; k < 3; ++k) d += (vertices[v][k] - p[k]) * (vertices[v][k] - p[k]);
+    if (d < best_d) {
+      best_d = d;
+      best = v;
+    }
+  }
+  return best;
 }
 
 class GuiApp : public ::testing::Test {
@@ -299,6 +333,144 @@ TEST_F(GuiApp, FileBrowserSavesAwayFromTheBundledFilesAndOpens) {
   ASSERT_FALSE(opened.is_null());
   EXPECT_FALSE(opened.at("browser").at("open").get<bool>());
   EXPECT_EQ(fs::path(opened.at("document").at("mesh").get<std::string>()).filename(), "other.obj");
+}
+
+// Mirrored sketching through the app's tools: with the mirror about x = 0, a node beside the
+// plane and two near it, joined by arcs, give a valid layout that is its own mirror image: every
+// node and every arc's path reflected lands on a node and an arc of the layout (this
+// tessellation is exactly symmetric, so within 1e-6 of the diagonal); the two plane nodes are
+// on the plane.
+TEST_F(GuiApp, MirroredSketchIsASymmetricLayout) {
+  const auto x = obj_vertices(kExampleMesh);
+  ASSERT_FALSE(x.empty());
+  const int top = nearest_vertex(x, {0.02, 0.95, 0.2});  // near the plane: goes onto it
+  const int side = nearest_vertex(x, {0.9, 0.1, 0.5});
+  const int bottom = nearest_vertex(x, {0.0, -0.3, 0.7});
+  const std::string nodes = "click_vertex " + std::to_string(top) + "\nclick_vertex " +
+                            std::to_string(side) + "\nclick_vertex " + std::to_string(bottom);
+  const std::string script =
+      "symmetry x\nwait_guides 60\nkey KP_1\nwait_camera\ntool place_node\n" + nodes +
+      "\ntool draw_arc\n" + nodes + "\nkey ESCAPE\nframes 2\nstate " + p("state.json") + "\nquit\n";
+  ASSERT_EQ(run_app({"--mesh", kExampleMesh.string()}, script), 0);
+  const json s = read_json(path("state.json"));
+  ASSERT_FALSE(s.is_null());
+  EXPECT_TRUE(s.at("symmetry").at("ready").get<bool>());
+  EXPECT_EQ(s.at("symmetry").at("normal"), json::array({1.0, 0.0, 0.0}));
+  const json& doc = s.at("document");
+  ASSERT_EQ(doc.at("nodes").size(), 4u) << s.at("status");  // side, its mirror, two on the plane
+  ASSERT_EQ(doc.at("arcs").size(), 4u) << s.at("status");
+  EXPECT_EQ(doc.at("validation_errors"), 0);
+  const double tolerance = 1e-6 * std::sqrt(2.6 * 2.6 + 2.0 * 2.0 + 1.5 * 1.5);
+  const auto mirrored = [&](int a, int b) {  // vertex b is the reflection of vertex a
+    return std::abs(x[a][0] + x[b][0]) < tolerance && std::abs(x[a][1] - x[b][1]) < tolerance &&
+           std::abs(x[a][2] - x[b][2]) < tolerance;
+  };
+  int on_plane = 0;
+  for (const auto& n : doc.at("nodes")) {
+    const int v = n.at("vertex");
+    on_plane += mirrored(v, v);
+    bool found = false;
+    for (const auto& m : doc.at("nodes")) found |= mirrored(v, m.at("vertex").get<int>());
+    EXPECT_TRUE(found) << "node " << n.at("id") << " has no mirror";
+  }
+  EXPECT_EQ(on_plane, 2);
+  for (const auto& a : doc.at("arcs")) {
+    const std::vector<int> pa = a.at("path");
+    bool found = false;
+    for (const auto& b : doc.at("arcs")) {
+      std::vector<int> pb = b.at("path");
+      for (int turn = 0; turn < 2 && !found; ++turn) {
+        bool same = pa.size() == pb.size();
+        for (std::size_t k = 0; same && k < pa.size(); ++k) same = mirrored(pa[k], pb[k]);
+        found = same;
+        std::reverse(pb.begin(), pb.end());
+      }
+    }
+    EXPECT_TRUE(found) << "arc " << a.at("id") << " has no mirror";
+  }
+}
+
+// The edge-loop tools through the app: a click on an arc inserts a loop through the chord
+// crossing it (4 nodes and 8 arcs more, the layout still valid, so every patch of this closed
+// surface is 4-sided: 2·#arcs = 4·#patches), a click on one of its arcs removes it again.
+TEST_F(GuiApp, EdgeLoopIsInsertedAndRemovedWithTheLoopTools) {
+  const fs::path exact = kAssets / "example" / "ellipsoid_exact.layout.json";
+  const json layout = read_json(exact);
+  const auto x = obj_vertices(kExampleMesh);
+  ASSERT_FALSE(layout.is_null() || x.empty());
+  // The front view looks along -z: an arc vertex with the largest z is in sight.
+  const auto frontmost = [&](const json& arcs, const json& skip) {
+    int best = -1;
+    for (const auto& a : arcs) {
+      if (!skip.is_null() && !arc_by_id(skip, a.at("id")).is_null()) continue;
+      const std::vector<int> path = a.at("path");
+      const int v = path[path.size() / 2];
+      if (path.size() >= 3 && (best < 0 || x[v][2] > x[best][2])) best = v;
+    }
+    return best;
+  };
+  const int insert_at = frontmost(layout.at("arcs"), nullptr);
+  ASSERT_GE(insert_at, 0);
+  ASSERT_EQ(run_app({"--mesh", kExampleMesh.string(), "--layout", exact.string()},
+                    "key KP_1\nwait_camera\ntool insert_loop\nclick_vertex " +
+                        std::to_string(insert_at) + "\nframes 2\nstate " + p("inserted.json") +
+                        "\nsave " + p("with_loop.layout.json") + "\nquit\n"),
+            0);
+  const json inserted = read_json(path("inserted.json"));
+  ASSERT_FALSE(inserted.is_null());
+  const json& with = inserted.at("document");
+  const std::size_t nodes = layout.at("nodes").size(), arcs = layout.at("arcs").size();
+  ASSERT_EQ(with.at("nodes").size(), nodes + 4) << inserted.at("status");
+  ASSERT_EQ(with.at("arcs").size(), arcs + 8);
+  EXPECT_EQ(with.at("validation_errors"), 0);
+  const int patches = int(with.at("arcs").size()) - int(with.at("nodes").size()) + 2;  // Euler
+  EXPECT_EQ(4 * patches, 2 * int(with.at("arcs").size()));
+
+  // Remove it through one of its new arcs, from the layout saved with the loop.
+  const int remove_at = frontmost(with.at("arcs"), layout);
+  ASSERT_GE(remove_at, 0);
+  ASSERT_EQ(
+      run_app({"--mesh", kExampleMesh.string(), "--layout", p("with_loop.layout.json")},
+              "key KP_1\nwait_camera\ntool remove_loop\nclick_vertex " + std::to_string(remove_at) +
+                  "\nframes 2\nstate " + p("removed.json") + "\nquit\n"),
+      0);
+  const json removed = read_json(path("removed.json"));
+  ASSERT_FALSE(removed.is_null());
+  EXPECT_EQ(removed.at("document").at("nodes").size(), nodes) << removed.at("status");
+  EXPECT_EQ(removed.at("document").at("arcs").size(), arcs);
+  EXPECT_EQ(removed.at("document").at("validation_errors"), 0);
+}
+
+// The guides through the app: a fitted mirror plane of the exactly symmetric example, and the
+// field hints' 8 singularities of index +1/4 (where a cube layout has its corners); a screenshot
+// with both is written. Without a mesh, waiting for them fails the script at once.
+TEST_F(GuiApp, GuidesAreShownAndWaitingWithoutAMeshFails) {
+  ASSERT_EQ(run_app({"--mesh", kExampleMesh.string()},
+                    "symmetry auto\nfield_hints on\nwait_guides 120\nframes 2\nscreenshot " +
+                        p("guides.png") + "\nstate " + p("state.json") + "\nquit\n"),
+            0);
+  const json s = read_json(path("state.json"));
+  ASSERT_FALSE(s.is_null());
+  EXPECT_TRUE(s.at("symmetry").at("ready").get<bool>());
+  EXPECT_LT(s.at("symmetry").at("residual").get<double>(), 1e-9);
+  // One of the ellipsoid's three mirror planes (all fit exactly: any may win).
+  double along_axis = 0.0;
+  for (const auto& c : s.at("symmetry").at("normal"))
+    along_axis = std::max(along_axis, std::abs(c.get<double>()));
+  EXPECT_NEAR(along_axis, 1.0, 1e-9);
+  EXPECT_NEAR(s.at("symmetry").at("offset").get<double>(), 0.0, 1e-9);
+  const json& singularities = s.at("field_hints").at("singularities");
+  ASSERT_TRUE(singularities.is_array());
+  EXPECT_EQ(singularities.size(), 8u);
+  for (const auto& v : singularities) EXPECT_EQ(v.at("index"), 1);
+  EXPECT_GT(fs::file_size(path("guides.png")), 1000u);
+
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(run_app({"--mesh", p("missing.obj")}, "symmetry x\nwait_guides 100\nquit\n"), 1);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(60));
+  std::ifstream log(path("run2.log"));
+  const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("wait_guides: no mesh is open"), std::string::npos) << text;
 }
 
 }  // namespace

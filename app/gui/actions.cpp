@@ -68,8 +68,9 @@ KeyBinding key_binding(int key, int mods) {
     default:
       break;
   }
-  if (key >= GLFW_KEY_1 && key < GLFW_KEY_1 + kToolCount)
+  if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9 && key - GLFW_KEY_1 < kToolCount)
     return {Action::SetTool, key - GLFW_KEY_1};
+  if (key == GLFW_KEY_0 && kToolCount >= 10) return {Action::SetTool, 9};
   return {};
 }
 

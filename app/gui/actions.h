@@ -2,7 +2,7 @@
 // keys on the numpad), and the actions the menus, keys and scripts share.
 //
 //   Ctrl+Z undo, Ctrl+Shift+Z / Ctrl+Y redo, Ctrl+O open, Ctrl+S save, Ctrl+Shift+S save as;
-//   1-8 tools, Delete / Backspace delete the selection, P pins it, Esc cancels;
+//   1-9 and 0 tools, Delete / Backspace delete the selection, P pins it, Esc cancels;
 //   numpad 1 / 3 / 7 front / right / top view (Ctrl: back / left / bottom), numpad 5
 //   perspective / orthographic, numpad 4 / 6 / 8 / 2 turn the view by 15 degrees, numpad .
 //   and F frame the selection, Home frames everything, R resets the view.

@@ -19,6 +19,10 @@ namespace {
 
 const std::set<std::string>& command_names() {
   static const std::set<std::string> names = {"frames",
+                                              "wait_guides",
+                                              "symmetry",
+                                              "field_hints",
+                                              "wireframe",
                                               "wait_step",
                                               "wait_finished",
                                               "wait_camera",
@@ -143,7 +147,9 @@ bool Automation::wait(const Command& c, bool done, double default_timeout_s) {
   if (c.args.size() > at) parse_double(c.args[at], timeout);
   if (std::chrono::duration<double>(now - wait_start_).count() > timeout) {
     waiting_ = false;
-    fail(c, "timed out after " + std::to_string(timeout) + " s");
+    char seconds[32];
+    std::snprintf(seconds, sizeof(seconds), "%g", timeout);
+    fail(c, std::string("timed out after ") + seconds + " s");
     return true;
   }
   return false;
@@ -193,6 +199,25 @@ bool Automation::run_command(const Command& c, AppContext& ctx, const glm::ivec2
                               latest->status == WorkerStatus::Failed));
   }
   if (n == "wait_camera") return wait(c, !ctx.camera.animating(), 30.0);
+  if (n == "wait_guides") {
+    // Guides that cannot come fail the script at once (no mesh, a failed computation).
+    const bool wanted = editor.symmetry.enabled() || editor.field_hints.enabled;
+    std::string why;
+    if (wanted && !editor.doc.mesh)
+      why = "no mesh is open";
+    else if (editor.symmetry.enabled() && !editor.symmetry.error().empty())
+      why = "mirror plane: " + editor.symmetry.error();
+    else if (editor.field_hints.enabled && !editor.field_hints.error().empty())
+      why = "field hints: " + editor.field_hints.error();
+    if (!why.empty()) {
+      waiting_ = false;
+      fail(c, why);
+      return true;
+    }
+    const bool plane = !editor.symmetry.enabled() || editor.mirror();
+    const bool hints = !editor.field_hints.enabled || editor.field_hints.field();
+    return wait(c, plane && hints);
+  }
   if (n == "wait_status") {
     const SnapshotPtr& latest = editor.job.latest();
     return wait(c, latest && !a.empty() && a[0] == to_string(latest->status));
@@ -231,6 +256,28 @@ bool Automation::run_command(const Command& c, AppContext& ctx, const glm::ivec2
       fail(c, "unknown tool");
     else
       ctx.tools.set_tool(tool);
+  } else if (n == "symmetry") {
+    if (a.empty()) {
+      fail(c, "expected: symmetry off|x|y|z|auto");
+    } else if (a[0] == "off") {
+      editor.symmetry.disable();
+    } else {
+      try {
+        editor.symmetry.enable(parse_symmetry_axis(a[0]));
+      } catch (const std::exception& e) {
+        fail(c, e.what());
+      }
+    }
+  } else if (n == "field_hints") {
+    if (a.empty() || (a[0] != "on" && a[0] != "off"))
+      fail(c, "expected: field_hints on|off");
+    else
+      editor.field_hints.enabled = a[0] == "on";
+  } else if (n == "wireframe") {
+    if (a.empty() || (a[0] != "on" && a[0] != "off"))
+      fail(c, "expected: wireframe on|off");
+    else if (ctx.renderer)
+      ctx.renderer->mesh_layer().wireframe = a[0] == "on";
   } else if (n == "click_vertex") {
     if (!arg_int(0, x)) return true;
     if (!editor.doc.mesh || x < 0 || x >= int(editor.doc.mesh->n_vertices())) {

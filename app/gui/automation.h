@@ -15,7 +15,12 @@
 //   run | step | pause | stop | keep | discard      the Pipeline panel's buttons
 //   set max_steps|descent_steps|node_optimization|publish_interval_ms V   a pipeline option
 //   tool NAME                select | place_node | draw_arc | split | delete | pin | stroke |
-//                            dangling
+//                            dangling | insert_loop | remove_loop
+//   symmetry off|x|y|z|auto  mirrored sketching off, or on about that plane (Sketch panel)
+//   field_hints on|off       the View panel's "Field hints"
+//   wireframe on|off         the View panel's wireframe of the surface
+//   wait_guides [S]          until the mirror plane and the field hints that are on are ready
+//                            (fails at once without a mesh or when their computation failed)
 //   click_vertex V           the current tool's click at mesh vertex V's screen position
 //   drag X0 Y0 X1 Y1         a left-button drag between window points (orbits off the nodes)
 //   stroke V1,V2,...         a stroke-tool stroke through those vertices

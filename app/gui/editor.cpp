@@ -56,6 +56,11 @@ Editor::Editor(EditorConfig config)
     : job(config.step ? config.step : editor_step_function(config.worker_nice)),
       config_(std::move(config)) {
   doc.editor.on_change = [this](const Layout& layout) { on_layout_edited(layout); };
+  // A node dragged with symmetry on takes its mirror node along.
+  doc.editor.drag_follow = [this](const Layout& before, Layout& moved, int node) {
+    const Mirror* m = mirror();
+    return m && doc.mesh ? follow_mirror(*doc.mesh, *m, before, moved, node) : std::string();
+  };
   if (config_.remember_recent) recent.load();
 }
 
@@ -289,6 +294,8 @@ void Editor::poll() {
     last_status_ = s.status;
   }
   if (!doc.editor.dragging()) doc.refresh_validation();
+  symmetry.poll(doc);
+  field_hints.poll(doc, config_.worker_nice);
   // The selection may name what an undo or a new layout removed.
   const Layout& layout = doc.editor.layout();
   if (selection.node >= 0 && layout.node_index(selection.node) < 0) selection.node = -1;
@@ -416,6 +423,20 @@ void Editor::apply(const EditResult& result, const std::string& done_message) {
   ++interaction_version;
 }
 
+void Editor::insert_edge_loop(int arc_id) {
+  const EditResult r = sketch_insert_edge_loop(doc.editor, mirror(), arc_id);
+  apply(r, "Edge loop inserted through the chord crossing arc " + std::to_string(arc_id) +
+               (mirror() ? " (and its mirror)" : ""));
+  if (r) selection = {r.id, -1};
+}
+
+void Editor::remove_edge_loop(int arc_id) {
+  const EditResult r = sketch_remove_edge_loop(doc.editor, mirror(), arc_id);
+  apply(r, "Edge loop through arc " + std::to_string(arc_id) + " removed" +
+               (mirror() ? " (and its mirror)" : ""));
+  if (r) selection = {};
+}
+
 void Editor::select(int node, int arc) {
   selection = {node, arc};
   ++interaction_version;
@@ -443,23 +464,37 @@ bool Editor::arc_pinned(int id) const {
 void Editor::toggle_node_pin(int id) {
   if (job.live_pins()) {
     const bool pinned = job.toggle_node_pin(id);
+    if (const Mirror* m = mirror(); m && doc.mesh) {
+      const Snapshot* s = result();
+      const Layout& shown = s && s->layout ? *s->layout : doc.editor.layout();
+      const int mid = mirror_node_id(*doc.mesh, shown, *m, id);
+      if (mid >= 0 && mid != id && job.node_pinned(mid) != pinned) job.toggle_node_pin(mid);
+    }
     ++interaction_version;
     set_status(std::string(pinned ? "Pinned" : "Unpinned") + " node " + std::to_string(id) +
                " in the run (from its next step)");
     return;
   }
-  apply(doc.editor.toggle_node_pin(id), "Pin toggled on node " + std::to_string(id));
+  apply(sketch_toggle_node_pin(doc.editor, mirror(), id),
+        "Pin toggled on node " + std::to_string(id));
 }
 
 void Editor::toggle_arc_pin(int id) {
   if (job.live_pins()) {
     const bool pinned = job.toggle_arc_pin(id);
+    if (const Mirror* m = mirror(); m && doc.mesh) {
+      const Snapshot* s = result();
+      const Layout& shown = s && s->layout ? *s->layout : doc.editor.layout();
+      const int mid = mirror_arc_id(*doc.mesh, shown, *m, id);
+      if (mid >= 0 && mid != id && job.arc_pinned(mid) != pinned) job.toggle_arc_pin(mid);
+    }
     ++interaction_version;
     set_status(std::string(pinned ? "Pinned" : "Unpinned") + " arc " + std::to_string(id) +
                " in the run (from its next step: its route and end nodes stay)");
     return;
   }
-  apply(doc.editor.toggle_arc_pin(id), "Pin toggled on arc " + std::to_string(id));
+  apply(sketch_toggle_arc_pin(doc.editor, mirror(), id),
+        "Pin toggled on arc " + std::to_string(id));
 }
 
 void Editor::toggle_pin_selection() {
@@ -474,11 +509,11 @@ void Editor::toggle_pin_selection() {
 void Editor::delete_selection() {
   if (selection.node >= 0) {
     const int id = selection.node;
-    apply(doc.editor.delete_node(id), "Node " + std::to_string(id) + " deleted");
+    apply(sketch_delete_node(doc.editor, mirror(), id), "Node " + std::to_string(id) + " deleted");
     selection.node = -1;
   } else if (selection.arc >= 0) {
     const int id = selection.arc;
-    apply(doc.editor.delete_arc(id), "Arc " + std::to_string(id) + " deleted");
+    apply(sketch_delete_arc(doc.editor, mirror(), id), "Arc " + std::to_string(id) + " deleted");
     selection.arc = -1;
   }
 }

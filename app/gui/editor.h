@@ -11,9 +11,11 @@
 
 #include "app/gui/autosave.h"
 #include "app/gui/document.h"
+#include "app/gui/field_hints.h"
 #include "app/gui/job_control.h"
 #include "app/gui/pipeline_job.h"
 #include "app/gui/recent_files.h"
+#include "app/gui/symmetry_state.h"
 
 namespace qs::app {
 
@@ -58,6 +60,10 @@ class Editor {
   std::string save_path;
   //! Bumped whenever the selection or a highlight changes (redraws the scene).
   std::uint64_t interaction_version = 0;
+  //! Mirrored sketching (the Sketch panel's Symmetry section).
+  SymmetryState symmetry;
+  //! The natural cross field of the bare mesh (the View panel's "Field hints").
+  FieldHints field_hints;
 
   // Start-up and files. Failures are reported (errors()) and leave the document as it was.
   //! Opens \p mesh_path and \p layout_path, or the bundled example when \p mesh_path is empty,
@@ -82,7 +88,8 @@ class Editor {
   //! Declines the offered autosave; it is kept as autosave.previous.layout.json.
   void discard_autosave();
 
-  //! Once per frame: the worker's latest snapshot and the validation of the edited layout.
+  //! Once per frame: the worker's latest snapshot, the validation of the edited layout, the
+  //! mirror plane and the field hints.
   void poll();
 
   // The pipeline.
@@ -104,10 +111,18 @@ class Editor {
   void export_files(const ExportSelection& what);
 
   // Edits and selection.
+  //! The mirror of the sketch edits (sketch_edits.h): null unless symmetry is on and its plane
+  //! is ready.
+  const Mirror* mirror() const { return symmetry.mirror(); }
   //! Reports an edit's outcome on the status line.
   void apply(const EditResult& result, const std::string& done_message);
+  //! Inserts / removes the edge loop through arc \p arc_id (mirrored with symmetry on), with
+  //! the outcome on the status line.
+  void insert_edge_loop(int arc_id);
+  void remove_edge_loop(int arc_id);
   void select(int node, int arc);
-  //! Pins / unpins: in the running (or paused) job when there is one, else in the layout.
+  //! Pins / unpins: in the running (or paused) job when there is one, else in the layout; with
+  //! symmetry on, the mirror node or arc too.
   void toggle_node_pin(int id);
   void toggle_arc_pin(int id);
   void toggle_pin_selection();

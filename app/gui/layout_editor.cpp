@@ -212,10 +212,64 @@ void LayoutEditor::set_layout(Layout layout) {
 void LayoutEditor::commit(std::string label, Layout before) {
   history_.resize(cursor_);  // a new edit drops the redo branch
   history_.push_back({std::move(label), std::move(before), layout_});
+  // Inside a group the steps are merged at its end: no trimming (indices stay) and one call.
+  if (group_depth_ == 0 && history_.size() > max_history) history_.erase(history_.begin());
+  cursor_ = history_.size();
+  ++version_;
+  if (group_depth_ == 0 && on_change) on_change(layout_);
+}
+
+EditResult LayoutEditor::edit(const std::string& label,
+                              const std::function<std::string(Layout&)>& change) {
+  if (auto r = check_mesh(); !r) return r;
+  Layout changed = layout_;
+  std::string error;
+  try {
+    error = change(changed);
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  if (!error.empty()) return EditResult::fail(error);
+  changed.patches.clear();
+  Layout before = std::move(layout_);
+  layout_ = std::move(changed);
+  commit(label, std::move(before));
+  return {};
+}
+
+EditResult LayoutEditor::group(const std::string& label, const std::function<EditResult()>& edits) {
+  if (group_depth_ > 0) return edits();
+  if (auto r = check_mesh(); !r) return r;
+  const std::size_t cursor = cursor_;
+  Layout before = layout_;
+  // The redo branch the first edit drops, for a group that fails.
+  std::vector<Step> redo(history_.begin() + static_cast<long>(cursor_), history_.end());
+  ++group_depth_;
+  EditResult result;
+  try {
+    result = edits();
+  } catch (const std::exception& e) {
+    result = EditResult::fail(e.what());
+  }
+  --group_depth_;
+  if (!result.ok) {
+    if (cursor_ != cursor) {
+      history_.resize(cursor);
+      history_.insert(history_.end(), std::make_move_iterator(redo.begin()),
+                      std::make_move_iterator(redo.end()));
+      cursor_ = cursor;
+      set_layout(std::move(before));
+    }
+    return result;
+  }
+  if (cursor_ == cursor) return result;  // nothing changed
+  history_.resize(cursor);
+  history_.push_back({label, std::move(before), layout_});
   if (history_.size() > max_history) history_.erase(history_.begin());
   cursor_ = history_.size();
   ++version_;
   if (on_change) on_change(layout_);
+  return result;
 }
 
 EditResult LayoutEditor::check_mesh() const {
@@ -534,6 +588,14 @@ EditResult LayoutEditor::drag_to(int vertex) {
   clear_node_outputs(moved.nodes[moved_index]);
   std::string error;
   if (!reroute_arcs_of(moved, drag_node_, &error)) return EditResult::fail(error);
+  if (drag_follow) {
+    try {
+      error = drag_follow(drag_before_, moved, drag_node_);
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    if (!error.empty()) return EditResult::fail(error);
+  }
   moved.patches.clear();
   set_layout(std::move(moved));
   return {};

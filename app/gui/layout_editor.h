@@ -94,6 +94,15 @@ class LayoutEditor {
   EditResult split_arc(int arc_id, int vertex);
   EditResult toggle_node_pin(int id);
   EditResult toggle_arc_pin(int id);
+  //! Applies \p change to a copy of the layout as one edit labelled \p label (edits composed
+  //! elsewhere: mirror images, edge loops). \p change returns "" to commit the copy, or why it
+  //! refuses (nothing changes). Patches are dropped.
+  EditResult edit(const std::string& label, const std::function<std::string(Layout&)>& change);
+  //! Runs \p edits (calls of this editor's edits) as one undo step labelled \p label: the steps
+  //! they record are merged, and on_change runs once. When \p edits returns a failed result or
+  //! throws, the layout and the history are restored and nothing is recorded. A group inside a
+  //! group is part of the outer one.
+  EditResult group(const std::string& label, const std::function<EditResult()>& edits);
   //! Replaces the whole layout (e.g. by the optimized one) as one undoable edit. Traced output
   //! fields (polylines, samples, labels, patches) are dropped: they describe the old solve.
   EditResult replace_layout(Layout layout, const std::string& label);
@@ -105,6 +114,10 @@ class LayoutEditor {
   void end_drag();
   void cancel_drag();
   bool dragging() const { return drag_node_ >= 0; }
+  //! Called by drag_to after the dragged node moved in \p moved (the layout before the drag,
+  //! \p before, with the node on its new vertex and its arcs re-routed): may change \p moved
+  //! further (e.g. move the mirror node along); a message refuses the position.
+  std::function<std::string(const Layout& before, Layout& moved, int node_id)> drag_follow;
 
   bool can_undo() const { return cursor_ > 0; }
   bool can_redo() const { return cursor_ < history_.size(); }
@@ -140,6 +153,7 @@ class LayoutEditor {
   std::size_t cursor_ = 0;  // steps [0, cursor_) are done, [cursor_, size) can be redone
   int drag_node_ = -1;
   Layout drag_before_;
+  int group_depth_ = 0;  //!< inside group(): steps are merged, on_change waits
 };
 
 //! Next free id (max + 1) among nodes or arcs.

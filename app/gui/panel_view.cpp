@@ -91,6 +91,34 @@ void draw_legend() {
   ImGui::TextUnformatted("problem");
 }
 
+// The natural cross field of the bare mesh and its singularities (before Run).
+void draw_field_hints(AppContext& ctx) {
+  FieldHints& hints = ctx.editor.field_hints;
+  ImGui::Checkbox("Field hints", &hints.enabled);
+  tooltip(
+      "The smoothest cross field of the bare mesh, following its curvature, sharp edges and "
+      "boundary with its singularities free: faint crosses, and rings where irregular nodes "
+      "belong (coloured like nodes: valence 3 / valence 5). Computed once per mesh in the "
+      "background.");
+  if (!hints.enabled) return;
+  ImGui::SameLine();
+  if (hints.computing()) {
+    text_colored(kDimColor, "computing...");
+  } else if (!hints.error().empty()) {
+    text_colored(kErrorColor, "failed: " + hints.error());
+  } else if (hints.field()) {
+    const int three = hints.count(1), five = hints.count(-1);
+    const int other = int(hints.field()->singularities.size()) - three - five;
+    color_swatch("valence 3", render::GuideColors::singularity(1));
+    ImGui::SameLine();
+    text(std::to_string(three));
+    ImGui::SameLine();
+    color_swatch("valence 5", render::GuideColors::singularity(-1));
+    ImGui::SameLine();
+    text(std::to_string(five) + (other > 0 ? " (+" + std::to_string(other) + " other)" : ""));
+  }
+}
+
 }  // namespace
 
 void draw_view_panel(AppContext& ctx) {
@@ -110,6 +138,7 @@ void draw_view_panel(AppContext& ctx) {
   ImGui::PushID("field_layer");
   renderer.field_layer().ui();
   ImGui::PopID();
+  draw_field_hints(ctx);
   draw_legend();
 #ifndef NDEBUG
   if (ImGui::Button("Reload shaders")) {

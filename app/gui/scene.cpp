@@ -48,6 +48,14 @@ render::SceneData build_scene(Editor& editor, const Tools& tools) {
     scene.arc_pin_overrides = editor.job.pending_arc_pins();
   }
   scene.interaction_version = editor.interaction_version * 1000003ull + tools.version();
+  if (editor.field_hints.enabled) {
+    scene.hints = editor.field_hints.field();
+    scene.hints_version = editor.field_hints.version();
+  }
+  if (const Mirror* m = editor.mirror()) {
+    scene.mirror = &m->plane;
+    scene.mirror_version = editor.symmetry.version();
+  }
   return scene;
 }
 

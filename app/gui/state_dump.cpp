@@ -90,6 +90,29 @@ json state_json(AppContext& ctx, int frames) {
     state["result"] = nullptr;
   }
   state["selection"] = {{"node", editor.selection.node}, {"arc", editor.selection.arc}};
+  json symmetry = {{"enabled", editor.symmetry.enabled()},
+                   {"axis", to_string(editor.symmetry.axis())},
+                   {"ready", editor.mirror() != nullptr},
+                   {"error", editor.symmetry.error()}};
+  if (const auto& fit = editor.symmetry.fit()) {
+    const MirrorPlane& p = fit->plane;
+    symmetry["normal"] = json::array({p.normal[0], p.normal[1], p.normal[2]});
+    symmetry["offset"] = p.offset;
+    symmetry["residual"] = fit->relative;
+  }
+  state["symmetry"] = symmetry;
+  json hints = {{"enabled", editor.field_hints.enabled},
+                {"computing", editor.field_hints.computing()},
+                {"error", editor.field_hints.error()}};
+  if (const NaturalField* f = editor.field_hints.field()) {
+    json singularities = json::array();
+    for (const auto& s : f->singularities)
+      singularities.push_back({{"vertex", s.vertex}, {"index", s.index}});
+    hints["singularities"] = singularities;
+  } else {
+    hints["singularities"] = nullptr;
+  }
+  state["field_hints"] = hints;
   state["tool"] = tool_name(ctx.tools.tool());
   const render::Camera& camera = ctx.camera;
   state["camera"] = {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "app/gui/sketch_edits.h"
 #include "core/layout/routing.h"
 
 namespace qs::app {
@@ -35,6 +36,12 @@ const ToolInfo kTools[kToolCount] = {
     {"Dangling arc", "dangling",
      "Click a node, then click near the mesh boundary: an arc from the node to the boundary "
      "(trimmed patches). Click the node twice for the nearest boundary."},
+    {"Insert loop", "insert_loop",
+     "Click an arc: a loop of arcs through every patch of the chord crossing it (each patch "
+     "split in two, all stay 4-sided)."},
+    {"Remove loop", "remove_loop",
+     "Click an arc of an edge loop (through valence-4 nodes): the whole loop is removed and "
+     "its patches merged."},
 };
 
 float distance_to_segment(const glm::vec2& p, const glm::vec2& a, const glm::vec2& b) {
@@ -67,6 +74,10 @@ std::optional<render::SurfaceHit> pick_surface(const glm::vec2& at, const Editor
 
 const char* tool_name(Tool tool) {
   return kTools[int(tool)].name;
+}
+
+char tool_key(Tool tool) {
+  return int(tool) == 9 ? '0' : char('1' + int(tool));
 }
 
 const char* tool_hint(Tool tool) {
@@ -191,13 +202,16 @@ void Tools::click(const glm::vec2& at, Editor& editor, const render::Camera& cam
       const int through = arc_through_vertex(layout_editor.layout(), hit->nearest_vertex);
       // Placing a node on an arc splits it: that is what sketching a T-junction means.
       if (through >= 0) {
-        const auto r = layout_editor.split_arc(through, hit->nearest_vertex);
+        const auto r =
+            sketch_split_arc(layout_editor, editor.mirror(), through, hit->nearest_vertex);
         editor.apply(r,
                      "Split arc " + std::to_string(through) + " with node " + std::to_string(r.id));
       } else {
-        const auto r = layout_editor.add_node(hit->nearest_vertex);
+        const auto r = sketch_add_node(layout_editor, editor.mirror(), hit->nearest_vertex);
+        const int k = layout_editor.layout().node_index(r.id);
         editor.apply(r, "Node " + std::to_string(r.id) + " placed on vertex " +
-                            std::to_string(hit->nearest_vertex));
+                            std::to_string(k >= 0 ? layout_editor.layout().nodes[k].vertex : -1) +
+                            (editor.mirror() ? " (mirrored)" : ""));
         if (r) editor.selection = {r.id, -1};
       }
       break;
@@ -214,7 +228,7 @@ void Tools::click(const glm::vec2& at, Editor& editor, const render::Camera& cam
         preview_target_vertex_ = -1;
         editor.set_status("Arc from node " + std::to_string(node) + ": click the end node");
       } else {
-        const auto r = layout_editor.add_arc(arc_start_node_, node);
+        const auto r = sketch_add_arc(layout_editor, editor.mirror(), arc_start_node_, node);
         editor.apply(r, "Arc " + std::to_string(r.id) + " added");
         // Chain: the end node starts the next arc, so outlines are drawn click by click.
         arc_start_node_ = r ? node : arc_start_node_;
@@ -253,7 +267,8 @@ void Tools::click(const glm::vec2& at, Editor& editor, const render::Camera& cam
             return;
           }
         }
-        const auto r = layout_editor.add_dangling_arc(arc_start_node_, target);
+        const auto r =
+            sketch_add_dangling_arc(layout_editor, editor.mirror(), arc_start_node_, target);
         editor.apply(r, "Dangling arc " + std::to_string(r.id) + " added");
         if (r) arc_start_node_ = -1;
       }
@@ -280,15 +295,17 @@ void Tools::click(const glm::vec2& at, Editor& editor, const render::Camera& cam
           best = a.path[i];
         }
       }
-      const auto r = layout_editor.split_arc(arc, best);
+      const auto r = sketch_split_arc(layout_editor, editor.mirror(), arc, best);
       editor.apply(r, "Split arc " + std::to_string(arc) + " with node " + std::to_string(r.id));
       break;
     }
     case Tool::Delete:
       if (node >= 0)
-        editor.apply(layout_editor.delete_node(node), "Node " + std::to_string(node) + " deleted");
+        editor.apply(sketch_delete_node(layout_editor, editor.mirror(), node),
+                     "Node " + std::to_string(node) + " deleted");
       else if (arc >= 0)
-        editor.apply(layout_editor.delete_arc(arc), "Arc " + std::to_string(arc) + " deleted");
+        editor.apply(sketch_delete_arc(layout_editor, editor.mirror(), arc),
+                     "Arc " + std::to_string(arc) + " deleted");
       if (node >= 0 && node == editor.selection.node) editor.selection.node = -1;
       if (arc >= 0 && arc == editor.selection.arc) editor.selection.arc = -1;
       break;
@@ -297,6 +314,19 @@ void Tools::click(const glm::vec2& at, Editor& editor, const render::Camera& cam
         editor.toggle_node_pin(node);
       else if (arc >= 0)
         editor.toggle_arc_pin(arc);
+      break;
+    case Tool::InsertLoop:
+    case Tool::RemoveLoop:
+      if (arc < 0) {
+        editor.set_status(tool_ == Tool::InsertLoop
+                              ? "Click an arc: the loop runs through the chord crossing it"
+                              : "Click an arc of the edge loop to remove");
+        return;
+      }
+      if (tool_ == Tool::InsertLoop)
+        editor.insert_edge_loop(arc);
+      else
+        editor.remove_edge_loop(arc);
       break;
   }
 }
@@ -429,7 +459,8 @@ void Tools::end_stroke(const glm::vec2& at, Editor& editor, const render::Camera
   add_stroke_sample(at, editor, camera, picker);
   int to = pick_node(at, kNodePickPx, editor, camera, picker);
   if (to == stroke_node_ && stroke_samples_.size() < 3) to = -1;  // a click, not a loop
-  const auto r = editor.doc.editor.add_stroke_arc(stroke_node_, to, stroke_samples_);
+  const auto r =
+      sketch_add_stroke_arc(editor.doc.editor, editor.mirror(), stroke_node_, to, stroke_samples_);
   if (r.ok && r.node_id >= 0)
     editor.apply(
         r, "Stroke arc " + std::to_string(r.id) + " to new node " + std::to_string(r.node_id));

@@ -1,6 +1,7 @@
 // The sketching tools and the mouse (GL-free): picking nodes, arcs and the surface under the
-// cursor, the tools' clicks and drags, free-hand strokes, and the camera drags (orbit, pan,
-// zoom). Acts on the Editor; reads the camera and the surface picker of the 3D view.
+// cursor, the tools' clicks and drags, free-hand strokes, edge loops, and the camera drags
+// (orbit, pan, zoom). Acts on the Editor (mirrored with its symmetry on: sketch_edits.h);
+// reads the camera and the surface picker of the 3D view.
 #pragma once
 
 #include <cstdint>
@@ -14,14 +15,27 @@
 
 namespace qs::app {
 
-enum class Tool { Select, PlaceNode, DrawArc, Split, Delete, Pin, Stroke, Dangling };
-constexpr int kToolCount = 8;
+enum class Tool {
+  Select,
+  PlaceNode,
+  DrawArc,
+  Split,
+  Delete,
+  Pin,
+  Stroke,
+  Dangling,
+  InsertLoop,
+  RemoveLoop
+};
+constexpr int kToolCount = 10;
+//! The key of a tool ('1'..'9', '0' for the tenth).
+char tool_key(Tool tool);
 
 const char* tool_name(Tool tool);
 //! One sentence on how to use the tool.
 const char* tool_hint(Tool tool);
 //! Script name of a tool ("select", "place_node", "draw_arc", "split", "delete", "pin",
-//! "stroke", "dangling"); false when \p name is none of them.
+//! "stroke", "dangling", "insert_loop", "remove_loop"); false when \p name is none of them.
 bool tool_from_name(const std::string& name, Tool& tool);
 
 //! One frame of mouse input, in window pixels (y down).

@@ -42,7 +42,7 @@ endif()
 # library also the key map, the camera views and the state dump.
 if(TARGET gui_editor_test)
   foreach(src editor job_control pipeline_job autosave recent_files layout_editor document
-      thread_priority file_browser plot_ticks ui_text)
+      thread_priority file_browser plot_ticks ui_text sketch_edits symmetry_state field_hints)
     target_sources(gui_editor_test PRIVATE ${PROJECT_SOURCE_DIR}/app/gui/${src}.cpp)
   endforeach()
   if(TARGET qs_render)
@@ -50,6 +50,19 @@ if(TARGET gui_editor_test)
       ${PROJECT_SOURCE_DIR}/app/gui/tools.cpp ${PROJECT_SOURCE_DIR}/app/gui/state_dump.cpp)
     target_link_libraries(gui_editor_test PRIVATE qs_render)
     target_compile_definitions(gui_editor_test PRIVATE QS_TEST_RENDER)
+  endif()
+endif()
+
+# gui_sketch_test.cpp: mirrored sketching, edge-loop edits and field hints through the editor's
+# state (GL-free); with the render library also the mirror plane's section curve.
+if(TARGET gui_sketch_test)
+  foreach(src editor job_control pipeline_job autosave recent_files layout_editor document
+      thread_priority file_browser plot_ticks ui_text sketch_edits symmetry_state field_hints)
+    target_sources(gui_sketch_test PRIVATE ${PROJECT_SOURCE_DIR}/app/gui/${src}.cpp)
+  endforeach()
+  if(TARGET qs_render)
+    target_link_libraries(gui_sketch_test PRIVATE qs_render)
+    target_compile_definitions(gui_sketch_test PRIVATE QS_TEST_RENDER)
   endif()
 endif()
 
