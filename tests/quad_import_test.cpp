@@ -92,12 +92,13 @@ TEST(QuadImport, CubeBaseComplexOntoSphereLikeMesh) {
   expect_matches_complex(r, "cube onto cube");
   EXPECT_EQ(r.layout.nodes.size(), 8u);
   EXPECT_EQ(r.layout.arcs.size(), 12u);
-  // Corners land exactly on the target's corners.
+  // Corners land exactly on the target's corners (its vertices, which the working mesh keeps).
   for (size_t n = 0; n < 8; ++n) {
     EXPECT_NEAR(
-        (target.point(VH(r.layout.nodes[n].vertex)) - scaled.point(VH(r.complex.node_vertex[n])))
+        (r.mesh.point(VH(r.layout.nodes[n].vertex)) - scaled.point(VH(r.complex.node_vertex[n])))
             .norm(),
         0.0, 1e-12);
+    EXPECT_LT(r.layout.nodes[n].vertex, static_cast<int>(target.n_vertices()));
   }
 }
 
@@ -394,7 +395,7 @@ TEST_F(RealQuads, FandiskOntoFandisk) {
   const double mean_edge = sum / target.n_edges();
   for (size_t n = 0; n < r.layout.nodes.size(); ++n) {
     const double d =
-        (target.point(VH(r.layout.nodes[n].vertex)) - quads.point(VH(r.complex.node_vertex[n])))
+        (r.mesh.point(VH(r.layout.nodes[n].vertex)) - quads.point(VH(r.complex.node_vertex[n])))
             .norm();
     EXPECT_LE(d, mean_edge) << "node " << n;
   }
@@ -421,78 +422,48 @@ TEST_F(RealQuads, JointAndInspiredOnTheirOwnQuads) {
   }
 }
 
-TEST_F(RealQuads, DenseComplexOntoCoarseTargetFailsClearly) {
-  // ... but not onto their coarser triangle meshes (known limitation, see the import report):
-  // the error names the nodes and says why.
+TEST_F(RealQuads, DenseComplexOntoCoarserTargetTransfers) {
+  // ... and onto their coarser triangle meshes too: the joint's base complex (3751 nodes, its
+  // separatrices spiral) onto joint_rem_p.obj (4387 vertices), on a working mesh of it.
   const PolyMesh quads = load_poly_mesh(dir_ + "/quadwild_joint/joint_rem_p_quadrangulation.obj");
   const TriMesh target = load_mesh(dir_ + "/quadwild_joint/joint_rem_p.obj");
-  try {
-    import_quads(quads, &target, {});
-    FAIL() << "expected InvalidInputError";
-  } catch (const InvalidInputError& e) {
-    EXPECT_NE(std::string(e.what()).find("too coarse"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("--coarsen"), std::string::npos) << e.what();
-  }
+  const QuadImportResult r = import_quads(quads, &target, {});
+  expect_matches_complex(r, "joint onto joint_rem_p");
+  ASSERT_TRUE(r.working);
+  EXPECT_EQ(r.transfer.input_vertices, static_cast<int>(target.n_vertices()));
+  EXPECT_EQ(r.transfer.working_faces, static_cast<int>(r.mesh.n_faces()));
+  EXPECT_LE(r.working->max_origin_error(), 1e-12);
+  // The target's vertices come first, unmoved.
+  for (const auto v : target.vertices()) ASSERT_EQ(r.mesh.point(v), target.point(v));
 }
 
-TEST_F(RealQuads, JointOntoItsTriangleMeshViaQuadWildPatches) {
-  // The joint's base complex spirals (3751 nodes) and cannot be transferred onto the coarser
-  // joint_rem_p.obj (4387 vertices); the import then falls back to QuadWild's own patches of that
-  // mesh, split into quads.
+TEST_F(RealQuads, CliTransfersOntoTheTargetsWorkingMesh) {
+  // import-quads --onto T writes T's working mesh and the layout on it; validate accepts them
+  // and the report gives the target's and the working mesh's sizes.
   const std::string base = dir_ + "/quadwild_joint/joint_rem_p";
-  const PolyMesh quads = load_poly_mesh(base + "_quadrangulation.obj");
-  const TriMesh target = load_mesh(base + ".obj");
-  const PatchPartition partition =
-      load_quadwild_partition(target, base + ".patch", base + ".corners");
-  QuadImportOptions options;
-  options.target_partition = &partition;
-  const QuadImportResult r = import_quads(quads, &target, options);
-  ASSERT_TRUE(r.via_partition);
-  ASSERT_FALSE(r.warnings.empty());
-  EXPECT_NE(r.warnings.back().find("patch partition"), std::string::npos) << r.warnings.back();
-  const ValidationResult vr = validate_layout(r.mesh, r.layout);
-  ASSERT_TRUE(vr.valid()) << (vr.issues.empty() ? "" : format_issue(vr.issues[0]));
-  // Patch count and node valences are those of the partition's own quad layout.
-  PatchLayoutStats stats;
-  const Layout direct = layout_from_partition(target, partition, &stats);
-  const LayoutTopology topo = build_topology(r.mesh, r.layout);
-  EXPECT_EQ(static_cast<int>(topo.patches.size()), stats.expected_patches);
-  EXPECT_EQ(topo.valence, build_topology(target, direct).valence);
-  EXPECT_EQ(topo.num_nodes - topo.num_arcs + static_cast<int>(topo.patches.size()), -2);
-  // The patch corners are vertices of the quadrangulation (its patches' corners): every corner
-  // node lies within one mean target edge length of a quad-mesh vertex.
-  double sum = 0;
-  for (const auto e : target.edges()) sum += target.calc_edge_length(e);
-  const double mean_edge = sum / target.n_edges();
-  ASSERT_GT(stats.partition_nodes, 0);
-  for (int n = 0; n < stats.partition_nodes; ++n) {
-    const Vec3 p = target.point(VH(r.layout.nodes[n].vertex));
-    double nearest = std::numeric_limits<double>::infinity();
-    for (const auto v : quads.vertices()) nearest = std::min(nearest, (quads.point(v) - p).norm());
-    EXPECT_LE(nearest, mean_edge) << "node " << n;
-  }
-  // Without the partition the transfer fails as before (see DenseComplexOntoCoarseTarget...).
-  EXPECT_THROW(import_quads(quads, &target, {}), InvalidInputError);
-}
-
-TEST_F(RealQuads, CliPicksUpQuadWildPatchesBesideTheTarget) {
-  // import-quads --onto T uses T.patch / T.corners when the base complex cannot be transferred.
-  const std::string base = dir_ + "/quadwild_joint/joint_rem_p";
-  const std::string out = test::temp_dir("import_quads_quadwild");
-  ASSERT_EQ(test::run_command(test::cli_path() + " import-quads --quiet --quads " + base +
-                              "_quadrangulation.obj --onto " + base + ".obj --out " + out),
-            0);
+  const std::string out = test::temp_dir("import_quads_onto");
+  std::string output;
+  ASSERT_EQ(test::run_command(test::cli_path() + " import-quads --quads " + base +
+                                  "_quadrangulation.obj --onto " + base + ".obj --out " + out,
+                              &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("growth"), std::string::npos) << output;
   std::ifstream in(out + "/report.json");
   const std::string report((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  EXPECT_NE(report.find("\"partition\""), std::string::npos) << report;
-  EXPECT_EQ(test::run_command(test::cli_path() + " validate --mesh " + out + "/mesh.obj --layout " +
-                              out + "/layout.json"),
-            0);
+  EXPECT_NE(report.find("\"working_mesh\""), std::string::npos) << report;
+  EXPECT_NE(report.find("\"growth\""), std::string::npos) << report;
+  ASSERT_EQ(test::run_command(test::cli_path() + " validate --mesh " + out + "/mesh.obj --layout " +
+                                  out + "/layout.json",
+                              &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("3753 patches"), std::string::npos) << output;
 }
 
 TEST_F(RealQuads, InspiredCoarsenedOntoItsTriangleMesh) {
   // The staircase boundary makes almost every vertex a node of the base complex; collapsing its
-  // thin chords makes the transfer onto the (boundary) triangle mesh possible.
+  // thin chords gives a coarser layout on the (boundary) triangle mesh.
   const PolyMesh quads = load_poly_mesh(dir_ + "/inspired_mesh/inspired_mesh_quads_Conjugate.off");
   const TriMesh target = load_mesh(dir_ + "/inspired_mesh/inspired_mesh.obj");
   QuadImportOptions options;
@@ -506,13 +477,10 @@ TEST_F(RealQuads, InspiredCoarsenedOntoItsTriangleMesh) {
   const LayoutTopology topo = build_topology(r.mesh, r.layout);
   EXPECT_EQ(topo.num_nodes - topo.num_arcs + static_cast<int>(topo.patches.size()), 1);
   for (const auto& patch : topo.patches) EXPECT_FALSE(patch.trimmed);
-  // Without coarsening the same transfer fails with a hint.
-  try {
-    import_quads(quads, &target, {});
-    FAIL() << "expected InvalidInputError";
-  } catch (const InvalidInputError& e) {
-    EXPECT_NE(std::string(e.what()).find("--coarsen"), std::string::npos) << e.what();
-  }
+  // Without coarsening the whole base complex transfers (one patch per quad).
+  const QuadImportResult full = import_quads(quads, &target, {});
+  expect_matches_complex(full, "inspired");
+  EXPECT_EQ(full.complex.num_patches, 1633);
 }
 
 TEST_F(RealQuads, QuadWildPatchesOfTheJointSplitIntoQuads) {
@@ -605,12 +573,6 @@ TEST(PatchImport, CubeFacesSplitIntoFourQuadsEach) {
     EXPECT_EQ(owner[q], partition.face_patch[f]);
   }
   for (int c : count) EXPECT_EQ(c, 4);
-  // As an import fallback the partition is used only when the transfer fails, and never for a
-  // quad mesh that does not lie on the target.
-  QuadImportOptions options;
-  options.target_partition = &partition;
-  EXPECT_FALSE(import_quads(quad_cube(4), &mesh, options).via_partition);
-  EXPECT_THROW(import_quads(quad_cube(4, Vec3(100, 0, 0)), &mesh, options), InvalidInputError);
 }
 
 TEST(PatchImport, RandomPartitionsGiveValidLayoutsOrClearErrors) {

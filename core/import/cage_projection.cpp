@@ -93,9 +93,37 @@ class Surface {
   explicit Surface(const TriMesh& target) : target_(target), tree_(target), boundary_(target) {
     normal_.resize(target.n_faces());
     for (const auto f : target.faces()) normal_[f.idx()] = unit_face_normal(target, f.idx());
+    vertex_normal_.assign(target.n_vertices(), Vec3(0, 0, 0));
+    for (const auto f : target.faces())
+      for (const auto v : target.fv_range(f)) vertex_normal_[v.idx()] += normal_[f.idx()];
+    for (Vec3& n : vertex_normal_)
+      if (n.norm() > 0) n.normalize();
   }
   bool has_boundary() const { return !boundary_.empty(); }
-  const Vec3& normal(const SurfacePoint& p) const { return normal_[p.face]; }
+
+  // The target's normal at p: its face's; on an edge the mean of the two faces' normals, at a
+  // vertex the mean of the faces' around it (a point on a sharp edge faces both ways).
+  Vec3 normal(const SurfacePoint& p) const {
+    int zeros = 0, nonzero = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (p.bary[k] == 0)
+        ++zeros;
+      else
+        nonzero = k;
+    }
+    if (zeros == 0) return normal_[p.face];
+    std::array<VH, 3> corner;
+    int k = 0;
+    for (const auto v : target_.fv_range(FH(p.face))) corner[k++] = v;
+    if (zeros == 2) return vertex_normal_[corner[nonzero].idx()];
+    int zero = 0;
+    while (p.bary[zero] != 0) ++zero;
+    const HH h = target_.find_halfedge(corner[(zero + 1) % 3], corner[(zero + 2) % 3]);
+    const FH other = target_.opposite_face_handle(h);
+    if (!other.is_valid()) return normal_[p.face];
+    const Vec3 n = normal_[p.face] + normal_[other.idx()];
+    return n.norm() > 0 ? n.normalized() : normal_[p.face];
+  }
 
   // The closest point to x: of the boundary when on_boundary, else of the surface among the
   // faces whose normal points along \p facing (all faces when none does, or facing is 0), moved
@@ -129,7 +157,7 @@ class Surface {
   const TriMesh& target_;
   ClosestPointTree tree_;
   BoundaryPoints boundary_;
-  std::vector<Vec3> normal_;
+  std::vector<Vec3> normal_, vertex_normal_;
 };
 
 // The projected face's (Newell) normal against the target's normals at its corners; 0 when
@@ -149,42 +177,37 @@ double face_sign(const PolyMesh& m, FH f, const ProjectedCage& p, const Surface&
 
 // Whether the first neighbours of v wind once around it in the cage's order (\p expected: +1,
 // or -1 for a target oriented against the cage). The turn from each neighbour to the next is
-// measured through the face between them (through its far corners, so that straight and
-// concave corners are not ambiguous) in the tangent plane of the target there (normal: the
-// target's normals at the face's corners summed); every face's turn must go the expected way,
-// and together they must make less than two turns (less than 3π: curved surfaces have other
+// measured through the face between them, triangle by triangle through its far corners (so
+// that straight and concave corners are not ambiguous): each triangle (v, p, q) turns by its
+// angle at v, signed by its orientation against the target's normals at its corners (a face
+// over a sharp edge of the target has no single tangent plane). Every face must turn the
+// expected way, and together less than two turns (less than 3π: curved surfaces have other
 // angle sums than 2π), or less than a full turn at a boundary vertex.
 bool winds_once(const PolyMesh& m, int v, const ProjectedCage& p, const Surface& surface,
                 double expected) {
   const Vec3& centre = p.position[v];
+  const Vec3 nv = surface.normal(p.point[v]);
   double turn = 0;
   for (const HH h : m.voh_range(VH(v))) {
     if (m.is_boundary(h)) continue;  // the exterior wedge of a boundary vertex
-    Vec3 n(0, 0, 0);
-    for (const auto u : m.fv_range(m.face_handle(h))) n += surface.normal(p.point[u.idx()]);
-    const double nl = n.norm();
-    if (!(nl > 0)) return false;
-    n /= nl;
-    bool degenerate = false;
-    auto direction = [&](int u) {
-      Vec3 d = p.position[u] - centre;
-      d -= (d | n) * n;
-      if (!(d.norm() > 0)) degenerate = true;
-      return d;
-    };
     double wedge = 0;
-    Vec3 last = direction(m.to_vertex_handle(h).idx());
+    int last = m.to_vertex_handle(h).idx();
     for (HH g = m.next_halfedge_handle(h); m.to_vertex_handle(g).idx() != v;
          g = m.next_halfedge_handle(g)) {
-      const Vec3 d = direction(m.to_vertex_handle(g).idx());
-      wedge += std::atan2(((last % d) | n), last | d);
-      last = d;
+      const int u = m.to_vertex_handle(g).idx();
+      const Vec3 a = p.position[last] - centre, b = p.position[u] - centre;
+      const Vec3 n = nv + surface.normal(p.point[last]) + surface.normal(p.point[u]);
+      const Vec3 cross = a % b;
+      const double angle = std::atan2(cross.norm(), a | b);
+      const double side = cross | n;
+      if (!(a.norm() > 0) || !(b.norm() > 0)) return false;
+      if (side == 0 && angle > 0) return false;  // straight back: no way to tell the side
+      wedge += side >= 0 ? angle : -angle;
+      last = u;
     }
-    if (degenerate || !(wedge * expected > 0)) return false;
+    if (!(wedge * expected > 0)) return false;
     turn += wedge;
   }
-  // Each wedge turned the expected way; all of them less than a second turn (the angle sum of a
-  // sharp cone is far below a full turn, that of a saddle above).
   const double full = 2 * std::numbers::pi;
   return std::abs(turn) < (m.is_boundary(VH(v)) ? full : 1.5 * full);
 }
@@ -219,11 +242,13 @@ std::vector<int> folded_vertices(const PolyMesh& m, const ProjectedCage& p, cons
 // Relaxes the projection where it folds: the folded vertices and a few rings around them (more
 // with every round) move to the mean of their neighbours (boundary vertices: of their boundary
 // neighbours, sliding along the target's boundary) and back onto the surface, a few sweeps a
-// round, until nothing folds or the rounds are used up. Returns the number of vertices moved.
+// round, until nothing folds or the rounds are used up. \p pinned vertices (none when empty)
+// stay; \p moved marks the vertices moved. Returns the number of vertices still folded.
 int relax_folds(const PolyMesh& m, ProjectedCage& p, const Surface& surface,
-                const std::vector<Vec3>& facing, double expected, int rounds) {
+                const std::vector<Vec3>& facing, double expected, int rounds,
+                const std::vector<char>& pinned, std::vector<char>& moved) {
   const int nv = static_cast<int>(m.n_vertices());
-  std::vector<char> moved(nv, 0), in_region(nv, 0);
+  std::vector<char> in_region(nv, 0);
   for (int round = 0; round < rounds; ++round) {
     std::vector<int> region = folded_vertices(m, p, surface, expected);
     if (region.empty()) break;
@@ -242,6 +267,7 @@ int relax_folds(const PolyMesh& m, ProjectedCage& p, const Surface& surface,
     }
     for (int sweep = 0; sweep < 3; ++sweep) {
       for (int v : region) {
+        if (!pinned.empty() && pinned[v]) continue;
         const bool boundary = m.is_boundary(VH(v));
         Vec3 sum(0, 0, 0);
         int n = 0;
@@ -256,13 +282,14 @@ int relax_folds(const PolyMesh& m, ProjectedCage& p, const Surface& surface,
       }
     }
   }
-  return static_cast<int>(std::count(moved.begin(), moved.end(), 1));
+  return static_cast<int>(folded_vertices(m, p, surface, expected).size());
 }
 
 }  // namespace
 
-ProjectedCage project_cage(const PolyMesh& dense, const TriMesh& target,
+ProjectedCage project_cage(const DenseCage& cage, const TriMesh& target,
                            const CageProjectionOptions& options) {
+  const PolyMesh& dense = cage.mesh;
   if (!(options.flow_offset > 0 && options.flow_offset <= 100))
     throw InvalidInputError("projection: flow_offset must be in (0, 100]");
   if (options.flow_steps < 1 || options.flow_steps > 1000)
@@ -345,8 +372,63 @@ ProjectedCage project_cage(const PolyMesh& dense, const TriMesh& target,
     }
     out.flow_steps = steps;
   }
-  out.relaxed_vertices = relax_folds(dense, out, surface, facing, orientation(dense, out, surface),
-                                     options.relax_rounds);
+  // The cage's own surface where it lies on the target: each quad-structure vertex whose linear
+  // position (its own) is at most as far from the target as its smoothed one (or within a
+  // thousandth of its mean edge length: a flat region), then every dense vertex whose faces all
+  // lie in quads with such corners only. Those vertices go to the closest points of their
+  // linear positions, and stay there while the relaxation can do without moving them.
+  if (cage.linear.size() != static_cast<size_t>(nv) || cage.quad_vertices > nv ||
+      cage.quad_of_face.size() != dense.n_faces())
+    throw InvalidInputError("projection: the dense cage is inconsistent");
+  std::vector<SurfacePoint> linear_point(nv);
+  std::vector<Vec3> linear_position(nv);
+  std::vector<char> own(cage.quad_vertices, 0);
+  for (int v = 0; v < cage.quad_vertices; ++v) {
+    surface.project(cage.linear[v], on_boundary[v], facing[v], linear_point[v], linear_position[v]);
+    double edge = 0;
+    int n = 0;
+    for (const auto h : dense.voh_range(VH(v))) {
+      edge += dense.calc_edge_length(h);
+      ++n;
+    }
+    const double offset = (linear_position[v] - cage.linear[v]).norm();
+    own[v] = offset <= out.offset[v] || (n > 0 && offset <= 1e-3 * edge / n);
+  }
+  int quads = 0;
+  for (const int q : cage.quad_of_face) quads = std::max(quads, q + 1);
+  std::vector<char> quad_on(quads, 1);
+  for (const auto f : dense.faces())
+    for (const auto v : dense.fv_range(f))
+      if (v.idx() < cage.quad_vertices && !own[v.idx()]) quad_on[cage.quad_of_face[f.idx()]] = 0;
+  std::vector<char> pinned(nv, 0);
+  for (const auto v : dense.vertices()) {
+    const int i = v.idx();
+    bool on = i < cage.quad_vertices ? own[i] : true;
+    if (i >= cage.quad_vertices) {
+      for (const auto f : dense.vf_range(v)) on = on && quad_on[cage.quad_of_face[f.idx()]];
+      if (on)
+        surface.project(cage.linear[i], on_boundary[i], facing[i], linear_point[i],
+                        linear_position[i]);
+    }
+    if (!on) continue;
+    out.point[i] = linear_point[i];
+    out.position[i] = linear_position[i];
+    out.offset[i] = (linear_position[i] - cage.linear[i]).norm();
+    pinned[i] = 1;
+  }
+  const double expected = orientation(dense, out, surface);
+  std::vector<char> moved(nv, 0);
+  const std::vector<SurfacePoint> start_point = out.point;
+  const std::vector<Vec3> start_position = out.position;
+  const int folded =
+      relax_folds(dense, out, surface, facing, expected, options.relax_rounds, pinned, moved);
+  if (folded > 0 && std::find(pinned.begin(), pinned.end(), 1) != pinned.end()) {
+    out.point = start_point;
+    out.position = start_position;
+    std::fill(moved.begin(), moved.end(), 0);
+    relax_folds(dense, out, surface, facing, expected, options.relax_rounds, {}, moved);
+  }
+  out.relaxed_vertices = static_cast<int>(std::count(moved.begin(), moved.end(), 1));
 
   out.boundary_midpoint.resize(dense.n_edges());
   for (const auto e : dense.edges()) {

@@ -40,18 +40,29 @@ struct ProjectedCage {
   std::vector<SurfacePoint> boundary_midpoint;
 };
 
-//! Projects every vertex of \p dense onto \p target: vertices on the boundary of \p dense go to
-//! the closest point of the target's boundary, the others to the closest surface point (moved
-//! into the face, a tenth of the way to its centroid, when that point lies on the target's
-//! boundary). Interior vertices flow first when the offset is large (CageProjectionOptions).
+//! Projects every vertex of \p cage.mesh (the dense cage) onto \p target: vertices on the
+//! boundary of the dense cage go to the closest point of the target's boundary, the others to
+//! the closest surface point (moved into the face, a tenth of the way to its centroid, when that
+//! point lies on the target's boundary). Interior vertices flow first when the offset is large
+//! (CageProjectionOptions). Where the cage itself lies on the target, its own surface is used
+//! instead of the smoothed one: a quad-structure vertex whose own position lies at most as far
+//! from the target as its smoothed position (or within 1e-3 of its mean edge length) goes to
+//! the closest point of its own position, and so does every dense vertex all of whose faces lie
+//! in quads with such corners only, at its DenseCage::linear position (a quad mesh on the
+//! surface keeps its vertices and edges, features included; a cage off the surface takes its
+//! subdivided positions).
 //! Where the result folds (a projected face turned against the target's normals, or a vertex
 //! whose neighbours do not wind once around it, see find_folds), the folded vertices and a few
 //! rings around them move to the mean of their neighbours and back onto the target (boundary
 //! vertices along the boundary), round after round, until nothing folds or
-//! options.relax_rounds are used up; find_folds reports what still folds.
+//! options.relax_rounds are used up: first with the vertices at their own positions kept in
+//! place, then, when that leaves folds, with all of them free; find_folds reports what still
+//! folds.
+//! \throw InvalidInputError also when \p cage is inconsistent (sizes of linear or
+//!        quad_of_face).
 //! \throw InvalidInputError when \p dense has a boundary and \p target has none, or the options
 //!        are out of range.
-ProjectedCage project_cage(const PolyMesh& dense, const TriMesh& target,
+ProjectedCage project_cage(const DenseCage& cage, const TriMesh& target,
                            const CageProjectionOptions& options = {});
 
 //! Where a projected dense cage folds.

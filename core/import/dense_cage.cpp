@@ -45,9 +45,10 @@ class CommonNeighbours {
 // parent face. Old vertices keep their indices (CatmullClarkT only adds vertices), so the new
 // vertex on old edge (a, b) is the only neighbour that a and b share afterwards, and the new
 // vertex of an old face is the neighbour shared by the new vertices of two consecutive edges of
-// that face other than their common corner.
+// that face other than their common corner. \p linear (one position per vertex) follows the
+// step as a linear subdivision: edge points at edge midpoints, face points at face centroids.
 void refine_once(PolyMesh& mesh, std::vector<int>& parent_of_face,
-                 std::vector<std::vector<int>>& chains) {
+                 std::vector<std::vector<int>>& chains, std::vector<Vec3>& linear) {
   // Which steps of the chains are edges (the others are jumps, kept as they are).
   std::vector<std::vector<char>> chain_edges(chains.size());
   for (size_t c = 0; c < chains.size(); ++c) {
@@ -74,12 +75,20 @@ void refine_once(PolyMesh& mesh, std::vector<int>& parent_of_face,
     return c[0];
   };
   std::vector<int> face_of_centre(mesh.n_vertices(), -1);
+  linear.resize(mesh.n_vertices());
   for (size_t f = 0; f < old_faces.size(); ++f) {
     const auto& c = old_faces[f];
     const int e0 = edge_point(c[0], c[1]), e1 = edge_point(c[1], c[2]);
     const std::vector<int> centre = common.of(e0, e1, c[1]);
     if (centre.size() != 1) throw std::logic_error("Catmull-Clark: no unique face point");
     face_of_centre[centre[0]] = static_cast<int>(f);
+    Vec3 sum(0, 0, 0);
+    for (size_t k = 0; k < c.size(); ++k) {
+      const int a = c[k], b = c[(k + 1) % c.size()];
+      sum += linear[a];
+      linear[edge_point(a, b)] = 0.5 * (linear[a] + linear[b]);
+    }
+    linear[centre[0]] = sum / static_cast<double>(c.size());
   }
   std::vector<int> parent(mesh.n_faces(), -1);
   for (const auto f : mesh.faces()) {
@@ -107,12 +116,14 @@ DenseCage subdivide_cage(const PolyMesh& cage, const PolyMesh& quads, const Quad
                          const DenseCageOptions& options) {
   DenseCage out;
   out.mesh = cage;
+  out.linear.reserve(cage.n_vertices());
+  for (const auto v : cage.vertices()) out.linear.push_back(cage.point(v));
   const bool ngons = !is_pure_quad(cage);
   std::vector<std::vector<int>> no_chains;
   if (ngons) {
     std::vector<int> parent(cage.n_faces());
     for (size_t f = 0; f < parent.size(); ++f) parent[f] = static_cast<int>(f);
-    refine_once(out.mesh, parent, no_chains);
+    refine_once(out.mesh, parent, no_chains, out.linear);
     out.levels = 1;
   }
   // The quad structure must be the mesh reached so far: same vertex count, same edges.
@@ -149,6 +160,7 @@ DenseCage subdivide_cage(const PolyMesh& cage, const PolyMesh& quads, const Quad
     out.quad_of_face[f.idx()] = it->second;
   }
   const int nq = static_cast<int>(quads.n_vertices());
+  out.quad_vertices = nq;
   for (size_t a = 0; a < complex.arcs.size(); ++a) {
     const auto& path = complex.arcs[a].path;
     bool valid = path.size() >= 2;
@@ -162,7 +174,7 @@ DenseCage subdivide_cage(const PolyMesh& cage, const PolyMesh& quads, const Quad
   }
   while (options.max_mean_edge > 0 && mean_edge_length(out.mesh) > options.max_mean_edge &&
          4 * out.mesh.n_faces() <= options.max_faces) {
-    refine_once(out.mesh, out.quad_of_face, out.arc_chains);
+    refine_once(out.mesh, out.quad_of_face, out.arc_chains, out.linear);
     ++out.levels;
     ++out.levels_below_quads;
   }

@@ -25,10 +25,16 @@ struct DenseCage {
   //! n-gons included). Its first #V(quads) vertices are the quad structure's vertices, same
   //! indices (moved by the subdivision's smoothing).
   PolyMesh mesh;
+  //! Per vertex of `mesh` (size #V): its position under the same steps of linear subdivision
+  //! (edge points at edge midpoints, face points at face centroids, old vertices unmoved): the
+  //! cage's own surface, where `mesh` has the smoothed one.
+  std::vector<Vec3> linear;
   int levels = 0;
   //! Levels between the quad structure and `mesh`: levels, or levels − 1 when the quad
   //! structure is the cage's first step (a cage with n-gons).
   int levels_below_quads = 0;
+  //! Vertices of the quad structure (they are the first ones of `mesh`).
+  int quad_vertices = 0;
   //! Per face of `mesh` (size #F): the face of the quad structure it lies in.
   std::vector<int> quad_of_face;
   //! Per arc of the complex: its vertex chain in `mesh` (node to node), each edge of the arc's

@@ -284,7 +284,7 @@ TransferResult transfer_quads(const PolyMesh& cage, const PolyMesh& quads,
   stats.subdivide_s = seconds_since(t0);
 
   t0 = Clock::now();
-  const ProjectedCage projected = project_cage(dense.mesh, *target);
+  const ProjectedCage projected = project_cage(dense, *target);
   const double diagonal = bbox_diagonal(*target);
   const double worst = *std::max_element(projected.offset.begin(), projected.offset.end());
   stats.max_offset = diagonal > 0 ? worst / diagonal : 0.0;
@@ -292,7 +292,8 @@ TransferResult transfer_quads(const PolyMesh& cage, const PolyMesh& quads,
   require_near(dense, projected, complex, options.max_distance_fraction * diagonal,
                options.max_distance_fraction);
   const CageFolds folds = find_folds(dense, projected, *target, complex.node_vertex);
-  result.reversed = folds.reversed;
+  stats.reversed = folds.reversed;
+  stats.relaxed_vertices = projected.relaxed_vertices;
   require_unfolded(folds, complex, !is_pure_quad(cage));
   stats.project_s = seconds_since(t0);
 
@@ -309,7 +310,7 @@ TransferResult transfer_quads(const PolyMesh& cage, const PolyMesh& quads,
   e.layout.mesh_vertices = static_cast<int>(w.n_vertices());
   e.layout.mesh_faces = static_cast<int>(w.n_faces());
   require_valid_layout(w, e.layout, "the transferred layout");
-  require_same_structure(w, e.layout, complex, result.reversed);
+  require_same_structure(w, e.layout, complex, stats.reversed);
   const MeshReport report = check_as_read(w);
   if (!report.ok()) throw InvalidInputError(rejection_message(report, "the working mesh"));
   stats.check_s = seconds_since(t0);
@@ -318,6 +319,7 @@ TransferResult transfer_quads(const PolyMesh& cage, const PolyMesh& quads,
   stats.working_faces = static_cast<int>(w.n_faces());
   stats.growth = e.mesh->growth();
   stats.max_origin_error = e.mesh->max_origin_error();
+  stats.min_angle_deg = e.mesh->min_angle_deg();
   result.mesh = e.mesh;
   result.layout = std::move(e.layout);
   return result;

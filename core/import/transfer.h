@@ -31,12 +31,15 @@ void validate_transfer_options(const TransferOptions& options);
 struct TransferStats {
   int levels = 0;  //!< Catmull–Clark steps of the cage
   int dense_vertices = 0, dense_faces = 0;
-  double max_offset = 0;  //!< largest distance of a dense vertex from the target / bbox diagonal
-  int flow_steps = 0;     //!< steps of the projection flow (0: closest points)
+  double max_offset = 0;     //!< largest distance of a dense vertex from the target / bbox diagonal
+  int flow_steps = 0;        //!< steps of the projection flow (0: closest points)
+  int relaxed_vertices = 0;  //!< dense vertices moved where the projection folded
+  bool reversed = false;     //!< the target is oriented against the quad structure
   int input_vertices = 0, input_faces = 0;      //!< the target mesh
   int working_vertices = 0, working_faces = 0;  //!< the working mesh
   double growth = 1;                            //!< working faces / target faces
   double max_origin_error = 0;                  //!< WorkingMesh::max_origin_error()
+  double min_angle_deg = 0;                     //!< WorkingMesh::min_angle_deg()
   EmbedStats embed;
   double subdivide_s = 0, project_s = 0, embed_s = 0, check_s = 0;  //!< wall-clock seconds
 };
@@ -47,7 +50,6 @@ struct TransferResult {
   //! vertex (no points), arcs by edge path; mesh_vertices/mesh_faces give the working mesh's
   //! size.
   Layout layout;
-  bool reversed = false;  //!< the target is oriented against the quad structure
   TransferStats stats;
 };
 
