@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <OpenMesh/Tools/Subdivider/Uniform/CatmullClarkT.hh>
+#include <OpenMesh/Tools/Subdivider/Uniform/LoopT.hh>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -100,6 +102,61 @@ TEST(QuadImport, CubeBaseComplexOntoSphereLikeMesh) {
         0.0, 1e-12);
     EXPECT_LT(r.layout.nodes[n].vertex, static_cast<int>(target.n_vertices()));
   }
+  // The arcs keep to the cube's edges: every vertex of every arc has two coordinates at 0 or 12.
+  for (const auto& arc : r.layout.arcs) {
+    for (const int v : arc.path) {
+      const Vec3 p = r.mesh.point(VH(v));
+      int on_faces = 0;
+      for (int k = 0; k < 3; ++k) on_faces += std::abs(p[k]) < 1e-9 || std::abs(p[k] - 12) < 1e-9;
+      EXPECT_GE(on_faces, 2) << "arc " << arc.id << " vertex " << v << " at " << p;
+    }
+  }
+}
+
+//! A pentagonal prism (2 pentagons, 5 quads), outward oriented: a subdivision cage with n-gons.
+PolyMesh pentagonal_prism() {
+  PolyMesh m;
+  std::vector<OpenMesh::VertexHandle> v;
+  for (int ring = 0; ring < 2; ++ring)
+    for (int i = 0; i < 5; ++i) {
+      const double a = 2 * M_PI * i / 5;
+      v.push_back(m.add_vertex(Vec3(2 * std::cos(a), 2 * std::sin(a), 3.0 * ring)));
+    }
+  m.add_face(std::vector<OpenMesh::VertexHandle>{v[4], v[3], v[2], v[1], v[0]});
+  m.add_face(std::vector<OpenMesh::VertexHandle>{v[5], v[6], v[7], v[8], v[9]});
+  for (int i = 0; i < 5; ++i) {
+    const int j = (i + 1) % 5;
+    m.add_face(std::vector<OpenMesh::VertexHandle>{v[i], v[j], v[5 + j], v[5 + i]});
+  }
+  return m;
+}
+
+//! The triangulated surface of \p levels Catmull-Clark steps of \p cage (n-gons as n-gons).
+TriMesh subdivision_surface(const PolyMesh& cage, int levels) {
+  PolyMesh fine = cage;
+  OpenMesh::Subdivider::Uniform::CatmullClarkT<PolyMesh> subdivider;
+  subdivider.attach(fine);
+  subdivider(levels);
+  subdivider.detach();
+  return triangulate_quads(fine, 1);
+}
+
+TEST(QuadImport, CageWithNgonsOntoItsSubdivisionSurface) {
+  // The cage lies off its subdivision surface (its corners up to a fifth of the diagonal away);
+  // its base complex and all its edges transfer, the n-gons split into quads.
+  const PolyMesh cage = pentagonal_prism();
+  const TriMesh target = subdivision_surface(cage, 3);
+  const QuadImportResult r = import_quads(cage, &target, {});
+  EXPECT_TRUE(r.split);
+  expect_matches_complex(r, "prism base complex");
+  ASSERT_TRUE(r.working);
+  EXPECT_LE(r.working->max_origin_error(), 1e-12);
+  for (const auto v : target.vertices()) ASSERT_EQ(r.mesh.point(v), target.point(v));
+  QuadImportOptions all;
+  all.all_edges = true;
+  const QuadImportResult e = import_quads(cage, &target, all);
+  expect_matches_complex(e, "prism all edges");
+  EXPECT_EQ(e.complex.num_patches, 5 * 4 + 2 * 5);
 }
 
 TEST(QuadImport, CoarsenedNotchedDiskIsOnePatch) {
@@ -435,6 +492,76 @@ TEST_F(RealQuads, DenseComplexOntoCoarserTargetTransfers) {
   EXPECT_LE(r.working->max_origin_error(), 1e-12);
   // The target's vertices come first, unmoved.
   for (const auto v : target.vertices()) ASSERT_EQ(r.mesh.point(v), target.point(v));
+}
+
+TEST_F(RealQuads, SpotCageOntoItsTriangleMesh) {
+  // The control cage (quads, triangles and pentagons, off the surface) onto the triangulated
+  // subdivision surface: its split into quads has the base complex of spot_quadrangulated.obj.
+  const PolyMesh cage = load_poly_mesh(dir_ + "/spot/spot_control_mesh.obj");
+  const TriMesh target = load_mesh(dir_ + "/spot/spot_triangulated.obj");
+  const QuadImportResult r = import_quads(cage, &target, {});
+  EXPECT_TRUE(r.split);
+  expect_matches_complex(r, "spot cage onto spot_triangulated");
+  EXPECT_EQ(r.layout.nodes.size(), 370u);
+  EXPECT_EQ(r.complex.num_patches, 368);
+  ASSERT_TRUE(r.working);
+  EXPECT_LE(r.working->max_origin_error(), 1e-12);
+  for (const auto v : target.vertices()) ASSERT_EQ(r.mesh.point(v), target.point(v));
+  // All its edges transfer as well (one patch per quad of the split).
+  QuadImportOptions all;
+  all.all_edges = true;
+  const QuadImportResult e = import_quads(cage, &target, all);
+  expect_matches_complex(e, "spot cage, all edges");
+  EXPECT_EQ(e.complex.num_patches, static_cast<int>(e.quads.n_faces()));
+}
+
+//! \p quads triangulated, 2 Loop subdivision steps, then 3 steps of Laplacian smoothing (each
+//! vertex halfway to the mean of its neighbours): a smooth surface near \p quads whose vertices
+//! are not those of \p quads.
+TriMesh loop_smoothed(const PolyMesh& quads) {
+  TriMesh mesh = triangulate_quads(quads, 1);
+  OpenMesh::Subdivider::Uniform::LoopT<TriMesh> loop;
+  loop.attach(mesh);
+  loop(2);
+  loop.detach();
+  std::vector<Vec3> next(mesh.n_vertices());
+  for (int step = 0; step < 3; ++step) {
+    for (const auto v : mesh.vertices()) {
+      Vec3 sum(0, 0, 0);
+      int n = 0;
+      for (const auto u : mesh.vv_range(v)) {
+        sum += mesh.point(u);
+        ++n;
+      }
+      next[v.idx()] = 0.5 * mesh.point(v) + 0.5 * sum / n;
+    }
+    for (const auto v : mesh.vertices()) mesh.point(v) = next[v.idx()];
+  }
+  return mesh;
+}
+
+TEST_F(RealQuads, AnimalsOntoSmoothedLoopSubdivisions) {
+  // The base mesh's base complex (its patches) onto a surface that none of its vertices lie on.
+  const std::map<std::string, int> patches{
+      {"cat_cat.obj", 1160}, {"cow_cow.obj", 1258}, {"pig_pig.obj", 940}};
+  for (const auto& [name, count] : patches) {
+    const PolyMesh quads = load_poly_mesh(dir_ + "/animals_basemesh/" + name);
+    const TriMesh target = loop_smoothed(quads);
+    const QuadImportResult r = import_quads(quads, &target, {});
+    expect_matches_complex(r, name);
+    EXPECT_EQ(r.complex.num_patches, count) << name;
+  }
+}
+
+TEST_F(RealQuads, InspiredQuadMeshesOntoTheirTriangleMesh) {
+  const TriMesh target = load_mesh(dir_ + "/inspired_mesh/inspired_mesh.obj");
+  for (const char* file : {"inspired_mesh_quads_Conjugate.off", "inspired_mesh_quads_Smooth.off"}) {
+    const PolyMesh quads = load_poly_mesh(dir_ + "/inspired_mesh/" + std::string(file));
+    const QuadImportResult r = import_quads(quads, &target, {});
+    expect_matches_complex(r, file);
+    // The staircase boundary makes the base complex one patch per quad.
+    EXPECT_EQ(r.complex.num_patches, static_cast<int>(quads.n_faces())) << file;
+  }
 }
 
 TEST_F(RealQuads, CliTransfersOntoTheTargetsWorkingMesh) {
