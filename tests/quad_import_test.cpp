@@ -160,9 +160,10 @@ TEST(QuadImport, CageWithNgonsOntoItsSubdivisionSurface) {
 }
 
 TEST(QuadImport, CoarsenedNotchedDiskIsOnePatch) {
+  // The coarsened complex is transferred onto a working mesh of the triangulated quad mesh,
+  // which needs no refinement up front (--refine 1).
   QuadImportOptions options;
   options.coarsen = 2.5;  // quad-mesh edge lengths (1 here)
-  options.refine = 3;
   const QuadImportResult r = import_quads(notched_disk(8), nullptr, options);
   EXPECT_EQ(r.coarsen.nodes_before, 8);
   EXPECT_EQ(r.coarsen.patches_before, 3);
@@ -171,6 +172,8 @@ TEST(QuadImport, CoarsenedNotchedDiskIsOnePatch) {
   EXPECT_EQ(r.layout.nodes.size(), 4u);
   EXPECT_EQ(r.layout.arcs.size(), 4u);
   EXPECT_EQ(r.complex.num_patches, 1);
+  ASSERT_TRUE(r.working);
+  EXPECT_EQ(r.transfer.input_faces, 2 * static_cast<int>(r.quads.n_faces()));
   // Without coarsening the exact base complex (3 patches) is kept.
   options.coarsen = 0;
   const QuadImportResult exact = import_quads(notched_disk(8), nullptr, options);
@@ -781,11 +784,10 @@ TEST(PatchImport, MalformedPartitionFilesAreClearErrors) {
 }
 
 TEST_F(RealQuads, JointCoarsenedOnItsOwnQuads) {
-  // The spiralling base complex of the QuadWild joint, coarsened by chord collapse, routed onto
-  // the quad mesh refined 3 x 3: a valid genus-2 layout with fewer patches.
+  // The spiralling base complex of the QuadWild joint, coarsened by chord collapse, transferred
+  // onto a working mesh of the triangulated quad mesh: a valid genus-2 layout with fewer patches.
   QuadImportOptions options;
   options.coarsen = 4;
-  options.refine = 3;
   const QuadImportResult r = import_quads(
       load_poly_mesh(dir_ + "/quadwild_joint/joint_rem_p_quadrangulation.obj"), nullptr, options);
   expect_matches_complex(r, "joint coarsened");

@@ -116,7 +116,7 @@ int run_import_quads(const ImportQuadsOptions& o, const CommonOptions& common) {
     if (result.working) {
       const TransferStats& t = result.transfer;
       report["transfer"] = {
-          {"target", {{"vertices", t.input_vertices}, {"faces", t.input_faces}}},
+          {"input", {{"vertices", t.input_vertices}, {"faces", t.input_faces}}},
           {"working_mesh", {{"vertices", t.working_vertices}, {"faces", t.working_faces}}},
           {"growth", t.growth},
           {"subdivision_levels", t.levels},
@@ -147,9 +147,10 @@ int run_import_quads(const ImportQuadsOptions& o, const CommonOptions& common) {
         std::ostringstream growth;
         growth.precision(3);
         growth << result.transfer.growth;
-        std::cerr << " (the working mesh of the target's " << result.transfer.input_vertices
-                  << " vertices / " << result.transfer.input_faces << " faces, growth "
-                  << growth.str() << "x)";
+        std::cerr << " (the working mesh of "
+                  << (o.onto.empty() ? "the triangulated quad mesh's " : "the target's ")
+                  << result.transfer.input_vertices << " vertices / " << result.transfer.input_faces
+                  << " faces, growth " << growth.str() << "x)";
       }
       std::cerr << ", " << seconds_since(t_total) << " s; wrote " << o.out
                 << "/mesh.obj and layout.json\n";

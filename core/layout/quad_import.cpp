@@ -657,17 +657,18 @@ QuadImportResult import_quads(const PolyMesh& quads, const TriMesh* target,
         static_cast<int>(result.complex.arcs.size());
     result.coarsen.patches_before = result.coarsen.patches_after = result.complex.num_patches;
   }
-  if (target) {
+  if (target || !result.complex.simple_paths) {
+    // Onto the target, or (a coarsened complex, whose arcs are no edge paths of the quad mesh)
+    // onto the triangulated quad mesh: on a working mesh of it.
     TransferOptions transfer;
     transfer.max_distance_fraction = options.max_distance_fraction;
-    TransferResult t = transfer_quads(quads, result.quads, result.complex,
-                                      std::make_shared<const TriMesh>(*target), transfer);
+    TransferResult t =
+        transfer_quads(quads, result.quads, result.complex,
+                       std::make_shared<const TriMesh>(target ? *target : result.mesh), transfer);
     result.working = t.mesh;
     result.transfer = t.stats;
     result.mesh = t.mesh->mesh();
     result.layout = std::move(t.layout);
-  } else if (!result.complex.simple_paths) {
-    result.layout = transfer_complex(result.quads, result.complex, result.mesh, options);
   } else {
     result.layout = layout_on_triangulation(result.quads, result.complex, options.refine);
     result.layout.mesh_vertices = static_cast<int>(result.mesh.n_vertices());
