@@ -79,7 +79,7 @@ void require_near(const DenseCage& dense, const ProjectedCage& projected,
                     "% of the target's bounding-box diagonal) from its surface, up to " +
                     format_length(worst) + ": quads " + join_ids(quads);
   if (!nodes.empty()) {
-    msg += "; nodes";
+    msg += ";";
     for (size_t i = 0; i < nodes.size() && i < 10; ++i) {
       const int n = nodes[i];
       msg += std::string(i ? "," : "") + " node " + std::to_string(n) + " (quad vertex " +
