@@ -191,6 +191,8 @@ TEST(QuadImport, FarFromTargetIsAnError) {
     EXPECT_NE(std::string(e.what()).find("does not lie on the target mesh"), std::string::npos)
         << e.what();
     EXPECT_NE(std::string(e.what()).find("node 0"), std::string::npos) << e.what();
+    // The target's resolution is never the problem (the working mesh refines).
+    EXPECT_EQ(std::string(e.what()).find("coarse"), std::string::npos) << e.what();
   }
 }
 
@@ -582,6 +584,7 @@ TEST_F(RealQuads, CliTransfersOntoTheTargetsWorkingMesh) {
   std::ifstream in(out + "/report.json");
   const std::string report((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(report.find("\"working_mesh\""), std::string::npos) << report;
+  EXPECT_NE(report.find("\"input\""), std::string::npos) << report;
   EXPECT_NE(report.find("\"growth\""), std::string::npos) << report;
   ASSERT_EQ(test::run_command(test::cli_path() + " validate --mesh " + out + "/mesh.obj --layout " +
                                   out + "/layout.json",
