@@ -119,6 +119,7 @@ int run_import_quads(const ImportQuadsOptions& o, const CommonOptions& common) {
           {"input", {{"vertices", t.input_vertices}, {"faces", t.input_faces}}},
           {"working_mesh", {{"vertices", t.working_vertices}, {"faces", t.working_faces}}},
           {"growth", t.growth},
+          {"min_angle_deg", t.min_angle_deg},
           {"subdivision_levels", t.levels},
           {"dense", {{"vertices", t.dense_vertices}, {"faces", t.dense_faces}}},
           {"max_offset", t.max_offset},
