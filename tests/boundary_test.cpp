@@ -228,13 +228,19 @@ TEST(Boundary, BoundaryNodesSlideOntoTheSquaresCorners) {
 }
 
 // The base complex of libigl's conjugate-field quad mesh of inspired_mesh, coarsened to 15
-// nodes and routed onto the triangle mesh (\p dir: the shared meshes).
+// nodes and routed onto the triangle mesh's own vertices and edges (transfer_complex, no
+// working mesh; \p dir: the shared meshes).
 QuadImportResult inspired_coarsened(const std::string& dir) {
-  const PolyMesh quads = test::load_poly_mesh(dir + "/inspired_mesh/inspired_mesh_quads_Conjugate.off");
+  const PolyMesh quads =
+      test::load_poly_mesh(dir + "/inspired_mesh/inspired_mesh_quads_Conjugate.off");
   const TriMesh target = test::load_mesh(dir + "/inspired_mesh/inspired_mesh.obj");
   QuadImportOptions io;
   io.coarsen = 16;
-  return import_quads(quads, &target, io);
+  QuadImportResult in = import_quads(quads, &target, io);
+  in.layout = transfer_complex(in.quads, in.complex, target, io);
+  in.mesh = target;
+  in.working.reset();
+  return in;
 }
 
 // Split curvature clusters (CrossFieldOptions::max_cluster_faces) on the coarsened

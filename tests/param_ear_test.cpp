@@ -49,10 +49,13 @@ TEST(ParamEar, InspiredMeshEarsAreNotFlattened) {
   const TriMesh target = load_mesh(dir + "/inspired_mesh/inspired_mesh.obj");
   QuadImportOptions io;
   io.coarsen = 8;
-  const QuadImportResult in = import_quads(quads, &target, io);
-  const std::vector<int> ears = ears_on_arcs(in.mesh, in.layout);
+  // The coarsened complex routed onto the target's own vertices and edges (transfer_complex,
+  // no refinement), where its boundary arcs turn at ears.
+  const QuadImportResult imported = import_quads(quads, &target, io);
+  const Layout layout = transfer_complex(imported.quads, imported.complex, target, io);
+  const std::vector<int> ears = ears_on_arcs(target, layout);
   ASSERT_FALSE(ears.empty()) << "the case must contain an ear on a boundary arc";
-  Pipeline pipeline(in.mesh, in.layout);
+  Pipeline pipeline(target, layout);
   const Parameterization& param = pipeline.compute_parameterization();
   for (int f : ears) EXPECT_GT(param_signed_area2(param.corner_uv, f), 0.0) << "ear face " << f;
   const ParamMetrics m = pipeline.metrics();

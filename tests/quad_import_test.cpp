@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <OpenMesh/Tools/Subdivider/Uniform/CatmullClarkT.hh>
+#include <OpenMesh/Tools/Subdivider/Uniform/LoopT.hh>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -92,19 +94,76 @@ TEST(QuadImport, CubeBaseComplexOntoSphereLikeMesh) {
   expect_matches_complex(r, "cube onto cube");
   EXPECT_EQ(r.layout.nodes.size(), 8u);
   EXPECT_EQ(r.layout.arcs.size(), 12u);
-  // Corners land exactly on the target's corners.
+  // Corners land exactly on the target's corners (its vertices, which the working mesh keeps).
   for (size_t n = 0; n < 8; ++n) {
     EXPECT_NEAR(
-        (target.point(VH(r.layout.nodes[n].vertex)) - scaled.point(VH(r.complex.node_vertex[n])))
+        (r.mesh.point(VH(r.layout.nodes[n].vertex)) - scaled.point(VH(r.complex.node_vertex[n])))
             .norm(),
         0.0, 1e-12);
+    EXPECT_LT(r.layout.nodes[n].vertex, static_cast<int>(target.n_vertices()));
+  }
+  // The arcs keep to the cube's edges: every vertex of every arc has two coordinates at 0 or 12.
+  for (const auto& arc : r.layout.arcs) {
+    for (const int v : arc.path) {
+      const Vec3 p = r.mesh.point(VH(v));
+      int on_faces = 0;
+      for (int k = 0; k < 3; ++k) on_faces += std::abs(p[k]) < 1e-9 || std::abs(p[k] - 12) < 1e-9;
+      EXPECT_GE(on_faces, 2) << "arc " << arc.id << " vertex " << v << " at " << p;
+    }
   }
 }
 
+//! A pentagonal prism (2 pentagons, 5 quads), outward oriented: a subdivision cage with n-gons.
+PolyMesh pentagonal_prism() {
+  PolyMesh m;
+  std::vector<OpenMesh::VertexHandle> v;
+  for (int ring = 0; ring < 2; ++ring)
+    for (int i = 0; i < 5; ++i) {
+      const double a = 2 * M_PI * i / 5;
+      v.push_back(m.add_vertex(Vec3(2 * std::cos(a), 2 * std::sin(a), 3.0 * ring)));
+    }
+  m.add_face(std::vector<OpenMesh::VertexHandle>{v[4], v[3], v[2], v[1], v[0]});
+  m.add_face(std::vector<OpenMesh::VertexHandle>{v[5], v[6], v[7], v[8], v[9]});
+  for (int i = 0; i < 5; ++i) {
+    const int j = (i + 1) % 5;
+    m.add_face(std::vector<OpenMesh::VertexHandle>{v[i], v[j], v[5 + j], v[5 + i]});
+  }
+  return m;
+}
+
+//! The triangulated surface of \p levels Catmull-Clark steps of \p cage (n-gons as n-gons).
+TriMesh subdivision_surface(const PolyMesh& cage, int levels) {
+  PolyMesh fine = cage;
+  OpenMesh::Subdivider::Uniform::CatmullClarkT<PolyMesh> subdivider;
+  subdivider.attach(fine);
+  subdivider(levels);
+  subdivider.detach();
+  return triangulate_quads(fine, 1);
+}
+
+TEST(QuadImport, CageWithNgonsOntoItsSubdivisionSurface) {
+  // The cage lies off its subdivision surface (its corners up to a fifth of the diagonal away);
+  // its base complex and all its edges transfer, the n-gons split into quads.
+  const PolyMesh cage = pentagonal_prism();
+  const TriMesh target = subdivision_surface(cage, 3);
+  const QuadImportResult r = import_quads(cage, &target, {});
+  EXPECT_TRUE(r.split);
+  expect_matches_complex(r, "prism base complex");
+  ASSERT_TRUE(r.working);
+  EXPECT_LE(r.working->max_origin_error(), 1e-12);
+  for (const auto v : target.vertices()) ASSERT_EQ(r.mesh.point(v), target.point(v));
+  QuadImportOptions all;
+  all.all_edges = true;
+  const QuadImportResult e = import_quads(cage, &target, all);
+  expect_matches_complex(e, "prism all edges");
+  EXPECT_EQ(e.complex.num_patches, 5 * 4 + 2 * 5);
+}
+
 TEST(QuadImport, CoarsenedNotchedDiskIsOnePatch) {
+  // The coarsened complex is transferred onto a working mesh of the triangulated quad mesh,
+  // which needs no refinement up front (--refine 1).
   QuadImportOptions options;
   options.coarsen = 2.5;  // quad-mesh edge lengths (1 here)
-  options.refine = 3;
   const QuadImportResult r = import_quads(notched_disk(8), nullptr, options);
   EXPECT_EQ(r.coarsen.nodes_before, 8);
   EXPECT_EQ(r.coarsen.patches_before, 3);
@@ -113,6 +172,8 @@ TEST(QuadImport, CoarsenedNotchedDiskIsOnePatch) {
   EXPECT_EQ(r.layout.nodes.size(), 4u);
   EXPECT_EQ(r.layout.arcs.size(), 4u);
   EXPECT_EQ(r.complex.num_patches, 1);
+  ASSERT_TRUE(r.working);
+  EXPECT_EQ(r.transfer.input_faces, 2 * static_cast<int>(r.quads.n_faces()));
   // Without coarsening the exact base complex (3 patches) is kept.
   options.coarsen = 0;
   const QuadImportResult exact = import_quads(notched_disk(8), nullptr, options);
@@ -130,6 +191,8 @@ TEST(QuadImport, FarFromTargetIsAnError) {
     EXPECT_NE(std::string(e.what()).find("does not lie on the target mesh"), std::string::npos)
         << e.what();
     EXPECT_NE(std::string(e.what()).find("node 0"), std::string::npos) << e.what();
+    // The target's resolution is never the problem (the working mesh refines).
+    EXPECT_EQ(std::string(e.what()).find("coarse"), std::string::npos) << e.what();
   }
 }
 
@@ -394,7 +457,7 @@ TEST_F(RealQuads, FandiskOntoFandisk) {
   const double mean_edge = sum / target.n_edges();
   for (size_t n = 0; n < r.layout.nodes.size(); ++n) {
     const double d =
-        (target.point(VH(r.layout.nodes[n].vertex)) - quads.point(VH(r.complex.node_vertex[n])))
+        (r.mesh.point(VH(r.layout.nodes[n].vertex)) - quads.point(VH(r.complex.node_vertex[n])))
             .norm();
     EXPECT_LE(d, mean_edge) << "node " << n;
   }
@@ -421,78 +484,119 @@ TEST_F(RealQuads, JointAndInspiredOnTheirOwnQuads) {
   }
 }
 
-TEST_F(RealQuads, DenseComplexOntoCoarseTargetFailsClearly) {
-  // ... but not onto their coarser triangle meshes (known limitation, see the import report):
-  // the error names the nodes and says why.
+TEST_F(RealQuads, DenseComplexOntoCoarserTargetTransfers) {
+  // ... and onto their coarser triangle meshes too: the joint's base complex (3751 nodes, its
+  // separatrices spiral) onto joint_rem_p.obj (4387 vertices), on a working mesh of it.
   const PolyMesh quads = load_poly_mesh(dir_ + "/quadwild_joint/joint_rem_p_quadrangulation.obj");
   const TriMesh target = load_mesh(dir_ + "/quadwild_joint/joint_rem_p.obj");
-  try {
-    import_quads(quads, &target, {});
-    FAIL() << "expected InvalidInputError";
-  } catch (const InvalidInputError& e) {
-    EXPECT_NE(std::string(e.what()).find("too coarse"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("--coarsen"), std::string::npos) << e.what();
+  const QuadImportResult r = import_quads(quads, &target, {});
+  expect_matches_complex(r, "joint onto joint_rem_p");
+  ASSERT_TRUE(r.working);
+  EXPECT_EQ(r.transfer.input_vertices, static_cast<int>(target.n_vertices()));
+  EXPECT_EQ(r.transfer.working_faces, static_cast<int>(r.mesh.n_faces()));
+  EXPECT_LE(r.working->max_origin_error(), 1e-12);
+  // The target's vertices come first, unmoved.
+  for (const auto v : target.vertices()) ASSERT_EQ(r.mesh.point(v), target.point(v));
+}
+
+TEST_F(RealQuads, SpotCageOntoItsTriangleMesh) {
+  // The control cage (quads, triangles and pentagons, off the surface) onto the triangulated
+  // subdivision surface: its split into quads has the base complex of spot_quadrangulated.obj.
+  const PolyMesh cage = load_poly_mesh(dir_ + "/spot/spot_control_mesh.obj");
+  const TriMesh target = load_mesh(dir_ + "/spot/spot_triangulated.obj");
+  const QuadImportResult r = import_quads(cage, &target, {});
+  EXPECT_TRUE(r.split);
+  expect_matches_complex(r, "spot cage onto spot_triangulated");
+  EXPECT_EQ(r.layout.nodes.size(), 370u);
+  EXPECT_EQ(r.complex.num_patches, 368);
+  ASSERT_TRUE(r.working);
+  EXPECT_LE(r.working->max_origin_error(), 1e-12);
+  for (const auto v : target.vertices()) ASSERT_EQ(r.mesh.point(v), target.point(v));
+  // All its edges transfer as well (one patch per quad of the split).
+  QuadImportOptions all;
+  all.all_edges = true;
+  const QuadImportResult e = import_quads(cage, &target, all);
+  expect_matches_complex(e, "spot cage, all edges");
+  EXPECT_EQ(e.complex.num_patches, static_cast<int>(e.quads.n_faces()));
+}
+
+//! \p quads triangulated, 2 Loop subdivision steps, then 3 steps of Laplacian smoothing (each
+//! vertex halfway to the mean of its neighbours): a smooth surface near \p quads whose vertices
+//! are not those of \p quads.
+TriMesh loop_smoothed(const PolyMesh& quads) {
+  TriMesh mesh = triangulate_quads(quads, 1);
+  OpenMesh::Subdivider::Uniform::LoopT<TriMesh> loop;
+  loop.attach(mesh);
+  loop(2);
+  loop.detach();
+  std::vector<Vec3> next(mesh.n_vertices());
+  for (int step = 0; step < 3; ++step) {
+    for (const auto v : mesh.vertices()) {
+      Vec3 sum(0, 0, 0);
+      int n = 0;
+      for (const auto u : mesh.vv_range(v)) {
+        sum += mesh.point(u);
+        ++n;
+      }
+      next[v.idx()] = 0.5 * mesh.point(v) + 0.5 * sum / n;
+    }
+    for (const auto v : mesh.vertices()) mesh.point(v) = next[v.idx()];
+  }
+  return mesh;
+}
+
+TEST_F(RealQuads, AnimalsOntoSmoothedLoopSubdivisions) {
+  // The base mesh's base complex (its patches) onto a surface that none of its vertices lie on.
+  const std::map<std::string, int> patches{
+      {"cat_cat.obj", 1160}, {"cow_cow.obj", 1258}, {"pig_pig.obj", 940}};
+  for (const auto& [name, count] : patches) {
+    const PolyMesh quads = load_poly_mesh(dir_ + "/animals_basemesh/" + name);
+    const TriMesh target = loop_smoothed(quads);
+    const QuadImportResult r = import_quads(quads, &target, {});
+    expect_matches_complex(r, name);
+    EXPECT_EQ(r.complex.num_patches, count) << name;
   }
 }
 
-TEST_F(RealQuads, JointOntoItsTriangleMeshViaQuadWildPatches) {
-  // The joint's base complex spirals (3751 nodes) and cannot be transferred onto the coarser
-  // joint_rem_p.obj (4387 vertices); the import then falls back to QuadWild's own patches of that
-  // mesh, split into quads.
-  const std::string base = dir_ + "/quadwild_joint/joint_rem_p";
-  const PolyMesh quads = load_poly_mesh(base + "_quadrangulation.obj");
-  const TriMesh target = load_mesh(base + ".obj");
-  const PatchPartition partition =
-      load_quadwild_partition(target, base + ".patch", base + ".corners");
-  QuadImportOptions options;
-  options.target_partition = &partition;
-  const QuadImportResult r = import_quads(quads, &target, options);
-  ASSERT_TRUE(r.via_partition);
-  ASSERT_FALSE(r.warnings.empty());
-  EXPECT_NE(r.warnings.back().find("patch partition"), std::string::npos) << r.warnings.back();
-  const ValidationResult vr = validate_layout(r.mesh, r.layout);
-  ASSERT_TRUE(vr.valid()) << (vr.issues.empty() ? "" : format_issue(vr.issues[0]));
-  // Patch count and node valences are those of the partition's own quad layout.
-  PatchLayoutStats stats;
-  const Layout direct = layout_from_partition(target, partition, &stats);
-  const LayoutTopology topo = build_topology(r.mesh, r.layout);
-  EXPECT_EQ(static_cast<int>(topo.patches.size()), stats.expected_patches);
-  EXPECT_EQ(topo.valence, build_topology(target, direct).valence);
-  EXPECT_EQ(topo.num_nodes - topo.num_arcs + static_cast<int>(topo.patches.size()), -2);
-  // The patch corners are vertices of the quadrangulation (its patches' corners): every corner
-  // node lies within one mean target edge length of a quad-mesh vertex.
-  double sum = 0;
-  for (const auto e : target.edges()) sum += target.calc_edge_length(e);
-  const double mean_edge = sum / target.n_edges();
-  ASSERT_GT(stats.partition_nodes, 0);
-  for (int n = 0; n < stats.partition_nodes; ++n) {
-    const Vec3 p = target.point(VH(r.layout.nodes[n].vertex));
-    double nearest = std::numeric_limits<double>::infinity();
-    for (const auto v : quads.vertices()) nearest = std::min(nearest, (quads.point(v) - p).norm());
-    EXPECT_LE(nearest, mean_edge) << "node " << n;
+TEST_F(RealQuads, InspiredQuadMeshesOntoTheirTriangleMesh) {
+  const TriMesh target = load_mesh(dir_ + "/inspired_mesh/inspired_mesh.obj");
+  for (const char* file : {"inspired_mesh_quads_Conjugate.off", "inspired_mesh_quads_Smooth.off"}) {
+    const PolyMesh quads = load_poly_mesh(dir_ + "/inspired_mesh/" + std::string(file));
+    const QuadImportResult r = import_quads(quads, &target, {});
+    expect_matches_complex(r, file);
+    // The staircase boundary makes the base complex one patch per quad.
+    EXPECT_EQ(r.complex.num_patches, static_cast<int>(quads.n_faces())) << file;
   }
-  // Without the partition the transfer fails as before (see DenseComplexOntoCoarseTarget...).
-  EXPECT_THROW(import_quads(quads, &target, {}), InvalidInputError);
 }
 
-TEST_F(RealQuads, CliPicksUpQuadWildPatchesBesideTheTarget) {
-  // import-quads --onto T uses T.patch / T.corners when the base complex cannot be transferred.
+TEST_F(RealQuads, CliTransfersOntoTheTargetsWorkingMesh) {
+  // import-quads --onto T writes T's working mesh and the layout on it; validate accepts them
+  // and the report gives the target's and the working mesh's sizes.
   const std::string base = dir_ + "/quadwild_joint/joint_rem_p";
-  const std::string out = test::temp_dir("import_quads_quadwild");
-  ASSERT_EQ(test::run_command(test::cli_path() + " import-quads --quiet --quads " + base +
-                              "_quadrangulation.obj --onto " + base + ".obj --out " + out),
-            0);
+  const std::string out = test::temp_dir("import_quads_onto");
+  std::string output;
+  ASSERT_EQ(test::run_command(test::cli_path() + " import-quads --quads " + base +
+                                  "_quadrangulation.obj --onto " + base + ".obj --out " + out,
+                              &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("growth"), std::string::npos) << output;
   std::ifstream in(out + "/report.json");
   const std::string report((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  EXPECT_NE(report.find("\"partition\""), std::string::npos) << report;
-  EXPECT_EQ(test::run_command(test::cli_path() + " validate --mesh " + out + "/mesh.obj --layout " +
-                              out + "/layout.json"),
-            0);
+  EXPECT_NE(report.find("\"working_mesh\""), std::string::npos) << report;
+  EXPECT_NE(report.find("\"input\""), std::string::npos) << report;
+  EXPECT_NE(report.find("\"growth\""), std::string::npos) << report;
+  ASSERT_EQ(test::run_command(test::cli_path() + " validate --mesh " + out + "/mesh.obj --layout " +
+                                  out + "/layout.json",
+                              &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("3753 patches"), std::string::npos) << output;
 }
 
 TEST_F(RealQuads, InspiredCoarsenedOntoItsTriangleMesh) {
   // The staircase boundary makes almost every vertex a node of the base complex; collapsing its
-  // thin chords makes the transfer onto the (boundary) triangle mesh possible.
+  // thin chords gives a coarser layout on the (boundary) triangle mesh.
   const PolyMesh quads = load_poly_mesh(dir_ + "/inspired_mesh/inspired_mesh_quads_Conjugate.off");
   const TriMesh target = load_mesh(dir_ + "/inspired_mesh/inspired_mesh.obj");
   QuadImportOptions options;
@@ -506,13 +610,10 @@ TEST_F(RealQuads, InspiredCoarsenedOntoItsTriangleMesh) {
   const LayoutTopology topo = build_topology(r.mesh, r.layout);
   EXPECT_EQ(topo.num_nodes - topo.num_arcs + static_cast<int>(topo.patches.size()), 1);
   for (const auto& patch : topo.patches) EXPECT_FALSE(patch.trimmed);
-  // Without coarsening the same transfer fails with a hint.
-  try {
-    import_quads(quads, &target, {});
-    FAIL() << "expected InvalidInputError";
-  } catch (const InvalidInputError& e) {
-    EXPECT_NE(std::string(e.what()).find("--coarsen"), std::string::npos) << e.what();
-  }
+  // Without coarsening the whole base complex transfers (one patch per quad).
+  const QuadImportResult full = import_quads(quads, &target, {});
+  expect_matches_complex(full, "inspired");
+  EXPECT_EQ(full.complex.num_patches, 1633);
 }
 
 TEST_F(RealQuads, QuadWildPatchesOfTheJointSplitIntoQuads) {
@@ -605,12 +706,6 @@ TEST(PatchImport, CubeFacesSplitIntoFourQuadsEach) {
     EXPECT_EQ(owner[q], partition.face_patch[f]);
   }
   for (int c : count) EXPECT_EQ(c, 4);
-  // As an import fallback the partition is used only when the transfer fails, and never for a
-  // quad mesh that does not lie on the target.
-  QuadImportOptions options;
-  options.target_partition = &partition;
-  EXPECT_FALSE(import_quads(quad_cube(4), &mesh, options).via_partition);
-  EXPECT_THROW(import_quads(quad_cube(4, Vec3(100, 0, 0)), &mesh, options), InvalidInputError);
 }
 
 TEST(PatchImport, RandomPartitionsGiveValidLayoutsOrClearErrors) {
@@ -692,11 +787,10 @@ TEST(PatchImport, MalformedPartitionFilesAreClearErrors) {
 }
 
 TEST_F(RealQuads, JointCoarsenedOnItsOwnQuads) {
-  // The spiralling base complex of the QuadWild joint, coarsened by chord collapse, routed onto
-  // the quad mesh refined 3 x 3: a valid genus-2 layout with fewer patches.
+  // The spiralling base complex of the QuadWild joint, coarsened by chord collapse, transferred
+  // onto a working mesh of the triangulated quad mesh: a valid genus-2 layout with fewer patches.
   QuadImportOptions options;
   options.coarsen = 4;
-  options.refine = 3;
   const QuadImportResult r = import_quads(
       load_poly_mesh(dir_ + "/quadwild_joint/joint_rem_p_quadrangulation.obj"), nullptr, options);
   expect_matches_complex(r, "joint coarsened");

@@ -3,13 +3,13 @@
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "app/cli/commands.h"
 #include "app/cli/report.h"
 #include "core/base/atomic_file.h"
 #include "core/base/errors.h"
 #include "core/layout/layout_io.h"
-#include "core/layout/patch_import.h"
 #include "core/layout/perturb.h"
 #include "core/layout/quad_import.h"
 #include "core/layout/validate.h"
@@ -76,26 +76,6 @@ int run_import_quads(const ImportQuadsOptions& o, const CommonOptions& common) {
     options.all_edges = o.all_edges;
     options.refine = o.refine;
     options.coarsen = o.coarsen;
-    // QuadWild's own patches of the --onto mesh (<stem>.patch and <stem>.corners beside it):
-    // the layout falls back to them when the base complex cannot be transferred.
-    PatchPartition partition;
-    std::string partition_files;
-    if (!o.onto.empty()) {
-      std::filesystem::path stem(o.onto);
-      stem.replace_extension();
-      const std::string patch_file = stem.string() + ".patch";
-      const std::string corners_file = stem.string() + ".corners";
-      if (std::filesystem::exists(patch_file) && std::filesystem::exists(corners_file)) {
-        try {
-          partition = load_quadwild_partition(target, patch_file, corners_file);
-          options.target_partition = &partition;
-          partition_files = patch_file + ", " + corners_file;
-        } catch (const InvalidInputError& e) {
-          std::cerr << "warning: ignoring the patch partition beside " << o.onto << ": " << e.what()
-                    << "\n";
-        }
-      }
-    }
     const auto t_import = std::chrono::steady_clock::now();
     set_activity("importing the quad mesh '" + o.quads + "'");
     const QuadImportResult result =
@@ -133,12 +113,19 @@ int run_import_quads(const ImportQuadsOptions& o, const CommonOptions& common) {
                              {"arcs", result.coarsen.arcs_after},
                              {"patches", result.coarsen.patches_after}}}};
     }
-    if (result.via_partition) {
-      report["partition"] = {{"files", partition_files},
-                             {"patches", result.partition_stats.partition_patches},
-                             {"corners", result.partition_stats.partition_nodes},
-                             {"sides", result.partition_stats.partition_arcs},
-                             {"quads", result.partition_stats.expected_patches}};
+    if (result.working) {
+      const TransferStats& t = result.transfer;
+      report["transfer"] = {
+          {"input", {{"vertices", t.input_vertices}, {"faces", t.input_faces}}},
+          {"working_mesh", {{"vertices", t.working_vertices}, {"faces", t.working_faces}}},
+          {"growth", t.growth},
+          {"min_angle_deg", t.min_angle_deg},
+          {"subdivision_levels", t.levels},
+          {"dense", {{"vertices", t.dense_vertices}, {"faces", t.dense_faces}}},
+          {"max_offset", t.max_offset},
+          {"flow_steps", t.flow_steps},
+          {"relaxed_vertices", t.relaxed_vertices},
+          {"reversed", t.reversed}};
     }
     report["timings_s"] = {
         {"load", load_s}, {"import", import_s}, {"total", seconds_since(t_total)}};
@@ -156,8 +143,18 @@ int run_import_quads(const ImportQuadsOptions& o, const CommonOptions& common) {
                 << report["layout"]["irregular_nodes"] << " irregular), "
                 << report["layout"]["arcs"] << " arcs, " << report["layout"]["patches"]
                 << " patches on " << result.mesh.n_vertices() << " vertices / "
-                << result.mesh.n_faces() << " faces, " << seconds_since(t_total) << " s; wrote "
-                << o.out << "/mesh.obj and layout.json\n";
+                << result.mesh.n_faces() << " faces";
+      if (result.working) {
+        std::ostringstream growth;
+        growth.precision(3);
+        growth << result.transfer.growth;
+        std::cerr << " (the working mesh of "
+                  << (o.onto.empty() ? "the triangulated quad mesh's " : "the target's ")
+                  << result.transfer.input_vertices << " vertices / " << result.transfer.input_faces
+                  << " faces, growth " << growth.str() << "x)";
+      }
+      std::cerr << ", " << seconds_since(t_total) << " s; wrote " << o.out
+                << "/mesh.obj and layout.json\n";
     }
     return 0;
   } catch (const std::exception& e) {

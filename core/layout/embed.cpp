@@ -1,6 +1,7 @@
 #include "core/layout/embed.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <deque>
 #include <string>
@@ -68,6 +69,133 @@ double mean_input_edge(const TriMesh& m) {
   return m.n_edges() > 0 ? sum / m.n_edges() : 1.0;
 }
 
+// Whether surface point p of the input lies on the input's boundary (exact zeros: on a boundary
+// edge, or at a boundary vertex).
+bool on_input_boundary(const TriMesh& in, const SurfacePoint& p) {
+  if (p.face < 0 || p.face >= static_cast<int>(in.n_faces())) return false;
+  std::array<VH, 3> corner;
+  int k = 0;
+  for (auto v : in.fv_range(in.face_handle(p.face))) corner[k++] = v;
+  for (int j = 0; j < 3; ++j) {
+    if (p.bary[j] == 1 && in.is_boundary(corner[j])) return true;
+    if (p.bary[j] != 0) continue;
+    const HH h = in.find_halfedge(corner[(j + 1) % 3], corner[(j + 2) % 3]);
+    if (h.is_valid() && in.is_boundary(in.edge_handle(h))) return true;
+  }
+  return false;
+}
+
+// A vertex for surface point p: a free vertex (no node, no arc) nearby is reused; a point on
+// the boundary gets a boundary vertex, any other point an interior vertex; arc edges are never
+// split. Throws InvalidInputError as WorkingMesh::insert_point.
+WorkingMesh::Inserted insert_free(WorkingMesh& w, const LayoutOccupancy& occ,
+                                  const SurfacePoint& p) {
+  const bool boundary = on_input_boundary(w.input(), p);
+  const TriMesh& m = w.mesh();
+  const auto may_reuse = [&](int v) {
+    return !occ.occupied(v) && m.is_boundary(VH(v)) == boundary;
+  };
+  const auto may_split = [&](int e) {
+    return occ.arc_on_edge(e) < 0 && m.is_boundary(m.edge_handle(e)) == boundary;
+  };
+  return w.insert_point(p, may_reuse, may_split);
+}
+
+// The path along the mesh boundary from boundary vertex source to boundary vertex target
+// through free vertices and free edges, the shorter of the two ways round, at most max_length
+// long; empty when neither way is free.
+std::vector<int> route_along_boundary(const WorkingMesh& w, const LayoutOccupancy& occ, int source,
+                                      int target, double max_length) {
+  const TriMesh& m = w.mesh();
+  HH out;  // the boundary halfedge leaving source
+  for (auto h : m.voh_range(VH(source)))
+    if (m.is_boundary(h)) out = h;
+  if (!out.is_valid() || !m.is_boundary(VH(target))) return {};
+  std::vector<int> best;
+  double best_length = max_length;
+  for (int way = 0; way < 2; ++way) {
+    // way 0 follows the boundary loop forwards (next halfedges), way 1 backwards.
+    HH h = way == 0 ? out : m.prev_halfedge_handle(out);
+    std::vector<int> path{source};
+    double length = 0;
+    while (true) {
+      const int v = (way == 0 ? m.to_vertex_handle(h) : m.from_vertex_handle(h)).idx();
+      length += m.calc_edge_length(h);
+      if (length > best_length || occ.arc_on_edge(m.edge_handle(h).idx()) >= 0) break;
+      path.push_back(v);
+      if (v == target) {
+        best = path;
+        best_length = length;
+        break;
+      }
+      if (v == source || occ.occupied(v)) break;
+      h = way == 0 ? m.next_halfedge_handle(h) : m.prev_halfedge_handle(h);
+    }
+  }
+  return best;
+}
+
+// Routes arc a from vertex source to vertex target through its points in order (see
+// EmbedOptions::through_points); along the boundary when `boundary`. Returns the path, or an
+// empty path (then the occupancy is as before; vertices placed for points stay, free).
+std::vector<int> route_through_points(WorkingMesh& w, LayoutOccupancy& occ, int a, int source,
+                                      int target, const std::vector<SurfacePoint>& points,
+                                      bool boundary, EmbedStats& stats) {
+  const TriMesh& m = w.mesh();
+  std::vector<int> path{source};
+  // Marks path[from..] (the new segment and the vertex before it) as arc a's.
+  auto mark_tail = [&](size_t from) {
+    occ.set_path(std::vector<int>(path.begin() + static_cast<long>(from), path.end()), a);
+  };
+  for (size_t i = 0; i <= points.size(); ++i) {
+    const bool last = i == points.size();
+    int goal = target;
+    if (!last) {
+      try {
+        goal = insert_free(w, occ, points[i]).vertex;
+      } catch (const InvalidInputError&) {
+        ++stats.skipped_points;
+        continue;
+      }
+      occ.sync();
+      if (goal == path.back() || occ.occupied(goal)) {
+        ++stats.skipped_points;
+        continue;
+      }
+      ++stats.point_vertices;
+    }
+    const int c = path.back();
+    const Vec3 xc = m.point(VH(c)), xg = m.point(VH(goal));
+    const double length = (xg - xc).norm();
+    std::vector<int> segment;
+    if (boundary) {
+      segment = route_along_boundary(w, occ, c, goal, 3 * length + 1e-12);
+    } else {
+      segment = route_straight(w, occ, c, goal, 0.15, &stats.route_splits);
+      if (segment.empty()) {
+        RouteRequest request;
+        request.source = c;
+        request.target = goal;
+        request.guide = {xc, xg};
+        request.guide_width = length;
+        segment = route_arc(w, occ, request, &stats.route_splits);
+      }
+    }
+    if (segment.size() < 2) {
+      if (!last) {
+        ++stats.skipped_points;
+        continue;
+      }
+      occ.set_path(path, -1);
+      return {};
+    }
+    const size_t from = path.size() >= 2 ? path.size() - 2 : 0;
+    path.insert(path.end(), segment.begin() + 1, segment.end());
+    mark_tail(from);
+  }
+  return path;
+}
+
 }  // namespace
 
 void validate_embed_options(const EmbedOptions& options) {
@@ -112,9 +240,18 @@ std::vector<int> working_path_of_input_path(const WorkingMesh& mesh,
   return out;
 }
 
-EmbeddedLayout embed_layout(std::shared_ptr<const TriMesh> input, const Layout& layout_in,
-                            const EmbedOptions& options) {
-  validate_embed_options(options);
+namespace {
+
+// Arcs that found no route in one attempt of embed_layout.
+struct RouteFailures {
+  std::vector<std::string> problems;
+  std::vector<int> arcs;
+};
+
+// One attempt of embed_layout, routing the arcs in \p first right after the boundary arcs.
+// \throw RouteFailures when only arc routes failed, InvalidInputError for other problems.
+EmbeddedLayout embed_attempt(std::shared_ptr<const TriMesh> input, const Layout& layout_in,
+                             const EmbedOptions& options, const std::vector<int>& first) {
   EmbeddedLayout result;
   result.mesh = std::make_shared<WorkingMesh>(input, options.mesh);
   WorkingMesh& w = *result.mesh;
@@ -159,8 +296,14 @@ EmbeddedLayout embed_layout(std::shared_ptr<const TriMesh> input, const Layout& 
       }
     } else if (node.point) {
       try {
-        const auto may_reuse = [&](int v) { return occ.node_at(v) < 0; };
-        const WorkingMesh::Inserted ins = w.insert_point(*node.point, may_reuse);
+        // A node on the boundary gets a boundary vertex, any other node an interior vertex.
+        const bool boundary = on_input_boundary(w.input(), *node.point);
+        const TriMesh& m = w.mesh();
+        const auto may_reuse = [&](int v) {
+          return occ.node_at(v) < 0 && m.is_boundary(VH(v)) == boundary;
+        };
+        const auto may_split = [&](int e) { return m.is_boundary(m.edge_handle(e)) == boundary; };
+        const WorkingMesh::Inserted ins = w.insert_point(*node.point, may_reuse, may_split);
         node.vertex = ins.vertex;
         ++(ins.created ? result.stats.inserted_nodes : result.stats.snapped_nodes);
       } catch (const InvalidInputError& e) {
@@ -201,9 +344,32 @@ EmbeddedLayout embed_layout(std::shared_ptr<const TriMesh> input, const Layout& 
   }
   if (!problems.empty()) throw InvalidInputError(list_problems(problems));
 
-  // 3. Routed arcs.
+  // 3. Arcs along the boundary (all their points on it) first, then the others breadth-first.
   const double width = options.corridor * mean_input_edge(w.input());
-  for (int a : breadth_first_arcs(layout)) {
+  std::vector<char> along_boundary(layout.arcs.size(), 0);
+  std::vector<int> order;
+  for (int a = 0; a < static_cast<int>(layout.arcs.size()); ++a) {
+    const LayoutArc& arc = layout.arcs[a];
+    const int from = layout.node_index(arc.from);
+    const int to = arc.to >= 0 ? layout.node_index(arc.to) : -1;
+    if (!arc.path.empty() || arc.points.empty() || from < 0 || to < 0) continue;
+    bool on = w.mesh().is_boundary(VH(layout.nodes[from].vertex)) &&
+              w.mesh().is_boundary(VH(layout.nodes[to].vertex));
+    for (const SurfacePoint& p : arc.points) on = on && on_input_boundary(w.input(), p);
+    if (!on) continue;
+    along_boundary[a] = 1;
+    order.push_back(a);
+  }
+  std::vector<char> queued = along_boundary;
+  for (int a : first) {
+    if (queued[a]) continue;
+    queued[a] = 1;
+    order.push_back(a);
+  }
+  for (int a : breadth_first_arcs(layout))
+    if (!queued[a]) order.push_back(a);
+  std::vector<int> failed;
+  for (int a : order) {
     LayoutArc& arc = layout.arcs[a];
     if (!arc.path.empty()) continue;
     const std::string who = "arc " + std::to_string(arc.id);
@@ -216,6 +382,43 @@ EmbeddedLayout embed_layout(std::shared_ptr<const TriMesh> input, const Layout& 
     RouteRequest request;
     request.source = layout.nodes[from].vertex;
     request.target = to >= 0 ? layout.nodes[to].vertex : -1;
+    if (along_boundary[a] || (options.through_points && to >= 0)) {
+      std::vector<SurfacePoint> points = arc.points;
+      bool valid = true;
+      for (const SurfacePoint& p : points) {
+        try {
+          w.position(p);
+        } catch (const InvalidInputError& e) {
+          problems.push_back(who + ": " + e.what());
+          valid = false;
+          break;
+        }
+      }
+      if (!valid) continue;
+      std::vector<int> path = route_through_points(w, occ, a, request.source, request.target,
+                                                   points, along_boundary[a] != 0, result.stats);
+      if (path.empty() && !along_boundary[a]) {
+        // The points may crowd another arc's (polylines that touch): one route guided by them.
+        request.guide.push_back(w.mesh().point(VH(request.source)));
+        for (const SurfacePoint& p : points) request.guide.push_back(w.position(p));
+        request.guide.push_back(w.mesh().point(VH(request.target)));
+        request.guide_width = width;
+        path = route_arc(w, occ, request, &result.stats.route_splits);
+        if (!path.empty()) ++result.stats.guided_arcs;
+      }
+      if (path.empty()) {
+        failed.push_back(a);
+        problems.push_back(who + " (node " + std::to_string(arc.from) + " to node " +
+                           std::to_string(arc.to) + "): no route through its points that " +
+                           "avoids the arcs and nodes placed before it" +
+                           (along_boundary[a] ? " along the boundary" : ""));
+        continue;
+      }
+      arc.path = std::move(path);
+      arc.points.clear();
+      occ.set_path(arc.path, a);
+      continue;
+    }
     if (!arc.points.empty()) {
       request.guide.push_back(w.mesh().point(VH(request.source)));
       try {
@@ -233,6 +436,7 @@ EmbeddedLayout embed_layout(std::shared_ptr<const TriMesh> input, const Layout& 
       path = route_arc(w, occ, request, &result.stats.route_splits);
     }
     if (path.empty()) {
+      failed.push_back(a);
       problems.push_back(who + " (node " + std::to_string(arc.from) + " to " +
                          (arc.to >= 0 ? "node " + std::to_string(arc.to) : "the boundary") +
                          "): no route that avoids the arcs and nodes placed before it");
@@ -242,6 +446,7 @@ EmbeddedLayout embed_layout(std::shared_ptr<const TriMesh> input, const Layout& 
     arc.points.clear();
     occ.set_path(arc.path, a);
   }
+  if (!problems.empty() && failed.size() == problems.size()) throw RouteFailures{problems, failed};
   if (!problems.empty()) throw InvalidInputError(list_problems(problems));
 
   // 4. Angles, then room.
@@ -259,6 +464,27 @@ EmbeddedLayout embed_layout(std::shared_ptr<const TriMesh> input, const Layout& 
   // The working mesh changes as nodes move: the layout names no mesh size.
   layout.mesh_vertices = layout.mesh_faces = -1;
   return result;
+}
+
+}  // namespace
+
+EmbeddedLayout embed_layout(std::shared_ptr<const TriMesh> input, const Layout& layout,
+                            const EmbedOptions& options) {
+  validate_embed_options(options);
+  // Arcs that find no route are routed first in up to 3 more attempts: an arc routed earlier
+  // may have taken the room it needed.
+  std::vector<int> first;
+  for (int attempt = 1;; ++attempt) {
+    try {
+      EmbeddedLayout result = embed_attempt(input, layout, options, first);
+      result.stats.attempts = attempt;
+      return result;
+    } catch (const RouteFailures& failures) {
+      if (attempt == 4) throw InvalidInputError(list_problems(failures.problems));
+      for (int a : failures.arcs)
+        if (std::find(first.begin(), first.end(), a) == first.end()) first.push_back(a);
+    }
+  }
 }
 
 }  // namespace qs

@@ -639,7 +639,6 @@ QuadImportResult import_quads(const PolyMesh& quads, const TriMesh* target,
     if (options.refine != 1) {
       result.warnings.push_back("--refine is ignored when transferring onto another mesh");
     }
-    result.mesh = *target;
   } else {
     result.mesh = triangulate_quads(result.quads, options.refine);
     require_readable_triangulation(result.mesh, options.refine);
@@ -659,34 +658,17 @@ QuadImportResult import_quads(const PolyMesh& quads, const TriMesh* target,
     result.coarsen.patches_before = result.coarsen.patches_after = result.complex.num_patches;
   }
   if (target || !result.complex.simple_paths) {
-    try {
-      result.layout = transfer_complex(result.quads, result.complex, result.mesh, options);
-    } catch (const InvalidInputError& transfer_error) {
-      if (!target || !options.target_partition) throw;
-      // The partition describes the target only: use it only when the quad mesh lies on it.
-      const ClosestPointTree tree(result.mesh);
-      const double max_distance = options.max_distance_fraction * mesh_scales(result.mesh).second;
-      for (const auto v : result.quads.vertices()) {
-        if (tree.closest(result.quads.point(v)).distance > max_distance) throw;
-      }
-      try {
-        result.layout =
-            layout_from_partition(result.mesh, *options.target_partition, &result.partition_stats);
-      } catch (const InvalidInputError& partition_error) {
-        throw InvalidInputError(std::string(transfer_error.what()) +
-                                "\n(the target's patch partition gives no layout either: " +
-                                partition_error.what() + ")");
-      }
-      result.via_partition = true;
-      result.warnings.push_back(
-          "the base complex (" + std::to_string(result.complex.node_vertex.size()) + " nodes, " +
-          std::to_string(result.complex.num_patches) + " patches) cannot be transferred (" +
-          transfer_error.what() +
-          "); the layout is made from the target's patch partition "
-          "instead (" +
-          std::to_string(result.partition_stats.partition_patches) + " patches split into " +
-          std::to_string(result.partition_stats.expected_patches) + " quads)");
-    }
+    // Onto the target, or (a coarsened complex, whose arcs are no edge paths of the quad mesh)
+    // onto the triangulated quad mesh: on a working mesh of it.
+    TransferOptions transfer;
+    transfer.max_distance_fraction = options.max_distance_fraction;
+    TransferResult t =
+        transfer_quads(quads, result.quads, result.complex,
+                       std::make_shared<const TriMesh>(target ? *target : result.mesh), transfer);
+    result.working = t.mesh;
+    result.transfer = t.stats;
+    result.mesh = t.mesh->mesh();
+    result.layout = std::move(t.layout);
   } else {
     result.layout = layout_on_triangulation(result.quads, result.complex, options.refine);
     result.layout.mesh_vertices = static_cast<int>(result.mesh.n_vertices());

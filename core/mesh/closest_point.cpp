@@ -127,6 +127,11 @@ double ClosestPointTree::box_distance_sq(const Node& node, const Vec3& p) {
 }
 
 ClosestPoint ClosestPointTree::closest(const Vec3& p) const {
+  return closest(p, {});
+}
+
+ClosestPoint ClosestPointTree::closest(const Vec3& p,
+                                       const std::function<bool(int)>& accept) const {
   ClosestPoint best;
   if (nodes_.empty()) return best;
   double best_sq = std::numeric_limits<double>::infinity();
@@ -139,6 +144,7 @@ ClosestPoint ClosestPointTree::closest(const Vec3& p) const {
     if (box_distance_sq(node, p) >= best_sq) continue;
     if (node.left < 0) {
       for (int i = node.begin; i < node.end; ++i) {
+        if (accept && !accept(order_[i])) continue;
         const auto& t = corners_[order_[i]];
         const TrianglePoint q = closest_point_on_triangle(p, t[0], t[1], t[2]);
         if (q.distance * q.distance < best_sq) {

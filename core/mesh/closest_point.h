@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <vector>
 
 #include "core/mesh/mesh.h"
@@ -39,6 +40,9 @@ class ClosestPointTree {
   //! The closest surface point to \p p (ties: the face found first). face == -1 only for a
   //! mesh without faces.
   ClosestPoint closest(const Vec3& p) const;
+  //! The closest surface point to \p p among the faces for which \p accept(face) is true
+  //! (face == -1 when there is none).
+  ClosestPoint closest(const Vec3& p, const std::function<bool(int)>& accept) const;
 
  private:
   struct Node {
