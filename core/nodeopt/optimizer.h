@@ -1,7 +1,7 @@
 // Node optimization by gradient descent on the residual E of energy (1) (paper §6.1, §7;
-// algorithm.md §6): alternating (A) field + parameterization solves with fixed nodes and
-// (B) a step of all unpinned nodes along −∇E, traced as straightest geodesics and realized by
-// relocating one mesh vertex per node; steps that raise E are undone and α halved.
+// docs/design.md, "Node optimization"): alternating (A) field + parameterization solves with fixed
+// nodes and (B) a step of all unpinned nodes along −∇E, traced as straightest geodesics and
+// realized by relocating one mesh vertex per node; steps that raise E are undone and α halved.
 #pragma once
 
 #include <array>
@@ -211,8 +211,9 @@ struct NodeOptOptions {
   //! → 7e-23 in 0.24 s CPU, the discrete baseline's E in 17 s).
   bool hop_cones_first = true;
   //! Fold-over removal after the descent: a last solve with strict orientation constraints
-  //! (algorithm.md §7.2, core/param/orientation.h) when fold-overs remain; `enabled` inside
-  //! `orientation` is set by the optimizer (CLI: --no-orientation clears orientation_at_end).
+  //! (docs/design.md, "Orientation constraints"; core/param/orientation.h) when fold-overs remain;
+  //! `enabled` inside `orientation` is set by the optimizer (CLI: --no-orientation clears
+  //! orientation_at_end).
   bool orientation_at_end = true;
   OrientationOptions orientation;
   //! The last fallback of the fold-over removal (with orientation_at_end): when fold-overs

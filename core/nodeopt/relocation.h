@@ -1,5 +1,5 @@
 // Continuous node positioning by vertex relocation and re-routing of a moved node's arcs
-// (paper §6.1.1, algorithm.md §6.4).
+// (paper §6.1.1; docs/design.md, "Node relocation").
 #pragma once
 
 #include <functional>

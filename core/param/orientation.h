@@ -1,7 +1,7 @@
 // Strict orientation constraints for the parameterization (paper §6.3 "Limitations of Node
-// Movement", algorithm.md §7.2): linear tri-sector constraints [BCE*13] on the faces that fold,
-// solved as a convex QP in the reduced unknowns by a primal-dual interior-point method whose
-// Newton systems are factorized by CHOLMOD (no extra dependency).
+// Movement"; docs/design.md, "Orientation constraints"): linear tri-sector constraints [BCE*13] on
+// the faces that fold, solved as a convex QP in the reduced unknowns by a primal-dual
+// interior-point method whose Newton systems are factorized by CHOLMOD (no extra dependency).
 //
 // Problem. The parameterization solve eliminates every equality constraint exactly:
 // x = Z·y + z0 (x: 2 values (u, v) per wedge, y: the free unknowns), and minimizes
@@ -77,7 +77,7 @@ namespace qs {
 
 //! Which frame the tri-sector rays are built in (see "Sector frame" above).
 enum class SectorFrame {
-  kField,     //!< the field frame (u_t, v_t) of each face (algorithm.md §7.2 as written)
+  kField,     //!< the field frame (u_t, v_t) of each face
   kSolution,  //!< the field frame turned by the unconstrained solution's rotation on the face
   kFieldThenSolution,  //!< kField; where fold-overs remain, kSolution too; fewer fold-overs kept
 };

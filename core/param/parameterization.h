@@ -1,6 +1,7 @@
-// Global seamless parameterization whose base complex realizes the layout (paper §5,
-// algorithm.md §4): energy (1) with anisotropic norm, node-connection constraints (3),
-// iso-line constraints for boundary/pinned arcs and feature edges, all eliminated exactly.
+// Global seamless parameterization whose base complex realizes the layout (paper §5;
+// docs/design.md, "Parameterization"): energy (1) with anisotropic norm, node-connection
+// constraints (3), iso-line constraints for boundary/pinned arcs and feature edges, all eliminated
+// exactly.
 #pragma once
 
 #include <array>
@@ -30,17 +31,18 @@ struct ParamOptions {
   //! Anisotropic norm (BZK09): misalignment is penalised `anisotropy` times more than scale.
   bool anisotropic = true;
   double anisotropy = 10.0;
-  //! Per-face weights w_t multiplying each face's term of (1) (stiffening, algorithm.md §7.1).
+  //! Per-face weights w_t multiplying each face's term of (1) (docs/design.md, "Stiffening").
   //! Empty (the default) means all 1; otherwise size #F, every entry > 0.
   std::vector<double> face_weights;
-  //! Tri-sector orientation constraints when the solve has fold-overs (algorithm.md §7.2).
+  //! Tri-sector orientation constraints when the solve has fold-overs (docs/design.md,
+  //! "Orientation constraints").
   OrientationOptions orientation;
   //! Fixed arc lengths (integer patch sizes, paper §8): one linear row per listed arc, added to
   //! the node-connection constraints. Arcs not in the layout or dangling are ignored. Lengths
   //! that contradict each other (e.g. two opposite patch sides with different values) make the
   //! constraint set incompatible (InvalidInputError naming the arcs).
   std::vector<ArcLength> arc_lengths;
-  //! Curl-reducing sizing field (paper §5.3, algorithm.md §4.4, core/param/sizing.h): the
+  //! Curl-reducing sizing field (paper §5.3, docs/design.md "Sizing field", sizing.h): the
   //! targets become e^{s_t} u_t, e^{s_t} v_t, with s recomputed from the field at every solve.
   SizingOptions sizing;
   //! Fill-reducing ordering of the reduced matrix from AMD on the wedge graph (one node per

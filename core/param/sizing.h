@@ -1,5 +1,5 @@
-// Curl-reducing sizing field (paper §5.3 after [RLL*06], algorithm.md §4.4): a per-face
-// log-scale s_t such that the scaled cross field e^{s} û, e^{s} v̂ is as close to curl-free
+// Curl-reducing sizing field (paper §5.3 after [RLL*06]; docs/design.md, "Sizing field"): a
+// per-face log-scale s_t such that the scaled cross field e^{s} û, e^{s} v̂ is as close to curl-free
 // (integrable, i.e. the gradient of a parameterization) as a scalar scale can make it. The
 // parameterization then aims at ∇u = e^{s_t} u_t, ∇v = e^{s_t} v_t instead of the unit targets.
 //
@@ -60,8 +60,8 @@ struct SizingOptions {
   std::vector<double> frozen_log_scale;
 };
 
-//! Per-face discrete curls of the matched field directions û and v̂ (algorithm.md §4.4),
-//! optionally of the scaled field e^{s} û, e^{s} v̂. Units: 1/length.
+//! Per-face discrete curls of the matched field directions û and v̂ (docs/design.md, "Sizing
+//! field"), optionally of the scaled field e^{s} û, e^{s} v̂. Units: 1/length.
 struct FieldCurl {
   std::vector<double> u, v;  //!< size #F each
 };

@@ -86,7 +86,7 @@ class Pipeline {
   const ValidationResult& validation() const { return validation_; }
 
   //! Moves the mesh vertices to \p mesh's positions (same connectivity, same layout): updates
-  //! the geometry in place (κ continued, algorithm.md §6.1) and drops the curvature and the
+  //! the geometry in place (docs/design.md, "Continuing κ") and drops the curvature and the
   //! extraction. The field and parameterization solvers are kept (their combinatorial setup
   //! and factorization patterns do not depend on positions); call compute_parameterization()
   //! to re-solve. \throw InvalidInputError when the vertex or face count differs.
