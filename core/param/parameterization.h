@@ -47,9 +47,8 @@ struct ParamOptions {
   SizingOptions sizing;
   //! Fill-reducing ordering of the reduced matrix from AMD on the wedge graph (one node per
   //! wedge's u, v unknowns; grouped_amd_ordering) instead of CHOLMOD's AMD on the full matrix.
-  //! The analysis costs about a third less (bunny 70K faces: 0.050 → 0.035 s CPU), but nnz(L)
-  //! was higher on three of four meshes tried (bunny +5 %, joint +10 %, bunny with another
-  //! layout +13 %; spot −1 %) and the factorization up to 5 % slower, so it is off.
+  //! The analysis is cheaper, but the factor usually has more fill, so it is off
+  //! (docs/benchmarks.md, "Design measurements").
   bool wedge_ordering = false;
   //! A fill-reducing order of the mesh's vertices (vertex_nested_dissection: entry k is the
   //! vertex eliminated k-th, size #V), or null. When set, a new reduced matrix's symbolic
@@ -57,9 +56,7 @@ struct ParamOptions {
   //! translations and the long columns of merged unknowns last) instead of AMD on the matrix.
   //! The vertex order does not depend on the layout: a Pipeline computes it once for all its
   //! solvers and the pipelines continued from it (PipelineOptions::order_vertices), as does the
-  //! node optimizer on smaller meshes (NodeOptOptions::vertex_ordering). Bunny, 70K faces, 150
-  //! patches: flops of a factorization −38 %, its time −20 %, the analysis −50 %; on the joint
-  //! (3751 nodes) nnz(L) +8 % (docs/benchmarks.md, session 22). Takes precedence over
+  //! node optimizer on smaller meshes (NodeOptOptions::vertex_ordering). Takes precedence over
   //! wedge_ordering.
   std::shared_ptr<const std::vector<int>> vertex_order;
   //! Runs independent parts of the stage on a second thread: the layout labels beside the cut
