@@ -11,8 +11,8 @@
 // every thread that calls CHOLMOD (SpdSolver does it).
 //
 // Such a capped region still costs libgomp a team: an allocation, a barrier and a futex wake
-// per region, and CHOLMOD opens up to three regions per supernode (4.7 million in the 25
-// descent steps of the 70K bunny: 16 % of the run, 8.8 s → 7.4 s without). solver_threads.cpp
+// per region, and CHOLMOD opens up to three regions per supernode, millions in a node
+// optimization of a large model (docs/benchmarks.md, "Design measurements"). solver_threads.cpp
 // therefore defines libgomp's GOMP_parallel itself; the dynamic linker binds CHOLMOD's calls to
 // it first. A region that libgomp would give one thread (it asks for one, or the thread's
 // max-active-levels is reached) runs inline in the calling thread, with the same thread number
