@@ -26,11 +26,9 @@ namespace qs {
 //! Sets how many threads the math libraries may use, process-wide (n ≥ 1; 0 restores the
 //! default, 1). OpenBLAS's pool is resized at once (when the library is OpenBLAS); the OpenMP
 //! part takes effect in each solver thread at its next limit_solver_threads_here().
-//! The default is 1 because more did not pay on the 2-core machines: on the 70K bunny
-//! (`optimize --steps 4`, idle machine) 2 threads took the same wall time (113 s vs 114 s) for
-//! 116 + 100 s user + system CPU instead of 99 + 16 s (OpenBLAS's and libgomp's idle threads
-//! spin). Without a set_solver_threads call an OPENBLAS_NUM_THREADS of the environment is
-//! kept.
+//! The default is 1: on two cores more threads gave the same wall time for much more CPU
+//! (OpenBLAS's and libgomp's idle threads spin; docs/benchmarks.md). Without a set_solver_threads
+//! call an OPENBLAS_NUM_THREADS of the environment is kept.
 void set_solver_threads(int n);
 
 //! The current limit (≥ 1).
