@@ -433,8 +433,8 @@ def main():
                   f"`{r['command'].replace(os.getcwd() + '/', '')}` |")
     md.append("")
 
-    # The measurement notes below the marker (one section per session, written by hand) are
-    # kept: only the part above it is this run's. Written to a temporary file and renamed, so
+    # The analysis below the marker (written by hand) is kept: only the part above it is this
+    # run's. Written to a temporary file and renamed, so
     # that an interrupted run leaves the page as it was.
     kept = previous_notes(args.markdown)
     md += [NOTES_MARKER, ""]

@@ -6,7 +6,7 @@
 // default-malloc: glibc's allocator defaults instead of the applications' keep_freed_memory().
 // descent: no hop polish and no fold-over removal after the descent (only the STEPS descent
 // steps are timed in "optimize"); fresh: NodeOptOptions::reuse_field off (a fresh Pipeline per
-// trial with re-routed arcs, the behaviour before session 3); parallel:
+// trial with re-routed arcs); parallel:
 // NodeOptOptions::parallel_retry on (two threads); steps: print every step.
 // Times are CPU seconds of the process (CLOCK_PROCESS_CPUTIME_ID: wall time is meaningless
 // on a shared, overloaded machine); run with OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1

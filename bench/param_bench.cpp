@@ -12,12 +12,12 @@
 // faces they carry the vertex order the Pipeline computed on its second thread beside the field
 // (PipelineOptions::order_vertices; its time is printed, it is not part of the stage), so the
 // stage's analysis is symbolic only. The unit keeps CHOLMOD's own AMD analysis (not timed) and
-// so its ordering. --no-vertex-order: AMD in the stage too, as before session 23.
+// so its ordering. --no-vertex-order: AMD in the stage too.
 //
 // The allocator keeps freed memory for reuse, as quadsketch-cli and the GUI do
 // (keep_freed_memory, core/base/allocator.h); --default-malloc keeps glibc's defaults, under
-// which every solve page-faults its factorization in again (before session 12 the bench ran
-// that way, which slowed the unit more than the stage: bunny unit 0.24 s instead of 0.13 s).
+// which every solve page-faults its factorization in again (that slows the unit more than the
+// stage).
 //
 // Stage and unit are measured in process CPU seconds and in wall seconds. The stage labels the
 // layout beside the cut graph and analyzes the reduced matrix beside the energy assembly on a

@@ -24,9 +24,9 @@
 // --hop-min-offset X, --hop-candidates N, --hop-max-evaluations N, --hop-max-failures N,
 // --hop-collective 0|1, --hop-cones 0|1, --hop-cone-rings N, --hop-cone-targets N,
 // --hop-cone-max-failures N, --hop-rounds N, --stall-gain X, --hop-alpha-growth X:
-// NodeOptOptions::hop_* / max_hop_rounds / stall_gain / hop_alpha_growth. The
-// session-4 polish: --hop-cones 0 --hop-collective 0 --hop-min-offset 0.25
-// --hop-max-evaluations 16 --hop-max-failures 0.
+// NodeOptOptions::hop_* / max_hop_rounds / stall_gain / hop_alpha_growth. A polish without
+// the cone and collective passes, for comparison: --hop-cones 0 --hop-collective 0
+// --hop-min-offset 0.25 --hop-max-evaluations 16 --hop-max-failures 0.
 //
 // Cases are built in process (tests/fixtures.cpp): the bundled ellipsoid sketch
 // (assets/example), a cube layout on an ellipsoid (cube_sphere(12), radii 1.3 / 1 / 0.75), the

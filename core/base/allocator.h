@@ -6,15 +6,11 @@
 // above its trim threshold, so every solve page-faults its memory in again, and the kernel
 // zeroes each page. Two solves on two threads of one process (NodeOptOptions::parallel_hops)
 // also contend for the process's memory map while they fault. Keeping freed memory for reuse
-// removes both: on the 70K bunny, `optimize` took 71 s instead of 84 s with parallel hops
-// (the hop sweeps 12–13 s instead of 16–18 s each, kernel time 3.8 s instead of 16 s).
-// The price is a resident size that does not shrink after a large solve (up to the trim
-// threshold of free memory is kept, per malloc arena). glibc gives threads up to 8 arenas per
-// core; the policy allows one per hardware thread, so the kept memory does not multiply with
-// the solver threads that come and go: the pig of `import-quads --refine 3`, displaced and
-// optimized, peaked at 3.1 GB resident with glibc's arena count and 2.1 GB with two arenas
-// (2.1 GB with glibc's defaults altogether: its live peak), the 150-patch bunny at 1.63 and
-// 1.45 GB, in the same time (docs/benchmarks.md, session 25).
+// removes both. The price is a resident size that does not shrink after a large solve (up to
+// the trim threshold of free memory is kept, per malloc arena). glibc gives threads up to 8
+// arenas per core; the policy allows one per hardware thread, so the kept memory does not
+// multiply with the solver threads that come and go. Time and peak memory with and without it:
+// docs/benchmarks.md, "Design measurements".
 #pragma once
 
 namespace qs {

@@ -113,8 +113,8 @@ extern "C" void GOMP_parallel(void (*fn)(void*), void* data, unsigned num_thread
 // SuiteSparse's clock (libsuitesparseconfig). Debian's CHOLMOD is built with its timers: its
 // supernodal factorization reads this clock before and after every dense BLAS call, only to add
 // the differences to cholmod_common's CPU time statistics (CHOLMOD_CPU_GEMM_TIME and the like),
-// which QuadSketch never reads; the reads were 3 % of the node optimization's main thread on the
-// 70K bunny (docs/benchmarks.md, session 18). Defined here, as GOMP_parallel above, the dynamic
+// which QuadSketch never reads, and the reads cost a measurable share of the node
+// optimization's main thread. Defined here, as GOMP_parallel above, the dynamic
 // linker binds CHOLMOD's calls to this definition: no clock is read and those statistics stay 0.
 // Nothing else in the process calls it (CHOLMOD times nothing else with it; QuadSketch times
 // with std::chrono).

@@ -11,8 +11,8 @@
 // every thread that calls CHOLMOD (SpdSolver does it).
 //
 // Such a capped region still costs libgomp a team: an allocation, a barrier and a futex wake
-// per region, and CHOLMOD opens up to three regions per supernode (4.7 million in the 25
-// descent steps of the 70K bunny: 16 % of the run, 8.8 s → 7.4 s without). solver_threads.cpp
+// per region, and CHOLMOD opens up to three regions per supernode, millions in a node
+// optimization of a large model (docs/benchmarks.md, "Design measurements"). solver_threads.cpp
 // therefore defines libgomp's GOMP_parallel itself; the dynamic linker binds CHOLMOD's calls to
 // it first. A region that libgomp would give one thread (it asks for one, or the thread's
 // max-active-levels is reached) runs inline in the calling thread, with the same thread number
@@ -26,11 +26,9 @@ namespace qs {
 //! Sets how many threads the math libraries may use, process-wide (n ≥ 1; 0 restores the
 //! default, 1). OpenBLAS's pool is resized at once (when the library is OpenBLAS); the OpenMP
 //! part takes effect in each solver thread at its next limit_solver_threads_here().
-//! The default is 1 because more did not pay on the 2-core machines: on the 70K bunny
-//! (`optimize --steps 4`, idle machine) 2 threads took the same wall time (113 s vs 114 s) for
-//! 116 + 100 s user + system CPU instead of 99 + 16 s (OpenBLAS's and libgomp's idle threads
-//! spin). Without a set_solver_threads call an OPENBLAS_NUM_THREADS of the environment is
-//! kept.
+//! The default is 1: on two cores more threads gave the same wall time for much more CPU
+//! (OpenBLAS's and libgomp's idle threads spin; docs/benchmarks.md). Without a set_solver_threads
+//! call an OPENBLAS_NUM_THREADS of the environment is kept.
 void set_solver_threads(int n);
 
 //! The current limit (≥ 1).

@@ -1,4 +1,4 @@
-// Quality metrics of a parameterization (paper §9.1, algorithm.md §8).
+// Quality metrics of a parameterization (paper §9.1; docs/design.md, "Metrics").
 #pragma once
 
 #include <array>

@@ -1,6 +1,6 @@
-// Patch charts (algorithm.md §5.2, paper Appendix D): every full quad patch of the traced base
-// complex gets one common 2D chart in which it is the rectangle [0,w]×[0,h], with point location
-// (patch coordinates → surface point). Built without splitting the mesh: a BFS over face
+// Patch charts (paper Appendix D; docs/design.md, "Patch charts"): every full quad patch of the
+// traced base complex gets one common 2D chart in which it is the rectangle [0,w]×[0,h], with point
+// location (patch coordinates → surface point). Built without splitting the mesh: a BFS over face
 // *instances* composes the transitions of the seamless parameterization, restricted to faces
 // whose mapped triangle overlaps the open patch rectangle.
 #pragma once

@@ -1,4 +1,4 @@
-// Block-structured quad mesh of a traced quad layout (paper §8, algorithm.md §5.3; issue #8):
+// Block-structured quad mesh of a traced quad layout (paper §8; docs/design.md, "Quad mesh"):
 // an m×n grid per patch, with counts that agree along every poly-chord, arcs sampled once and
 // shared (watertight), interior points located in the patch charts. Plus the exports:
 // quads.obj, patches.json and layout_curves.obj.

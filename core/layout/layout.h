@@ -1,5 +1,5 @@
 // Quad layout model: nodes on mesh vertices, arcs as mesh edge paths, the rotation system
-// (σ, θ) on half-arcs, and patches (algorithm.md §1.1–1.2).
+// (σ, θ) on half-arcs, and patches (docs/design.md, "Layout model").
 #pragma once
 
 #include <array>
@@ -60,7 +60,7 @@ struct Layout {
   int arc_index(int id) const;
 };
 
-//! Combinatorial structure of a layout embedded in a mesh (algorithm.md §1.1–1.2).
+//! Combinatorial structure of a layout embedded in a mesh (docs/design.md, "Layout model").
 //! Half-arc 2a sits at arc a's `from` node, 2a+1 at its `to` node (for a dangling arc, 2a+1
 //! is the boundary end and has no node). Indices (not ids) throughout.
 struct LayoutTopology {

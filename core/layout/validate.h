@@ -37,8 +37,8 @@ struct ValidationResult {
   int warnings() const;  //!< the same for Warning issues
 };
 
-//! Checks a layout against a mesh (interfaces.md §1, algorithm.md §1.2): ids, paths,
-//! disjointness, dangling ends, patch disks, patch valences, Euler characteristic,
+//! Checks a layout against a mesh (docs/interfaces.md §1; docs/design.md, "Layout model"): ids,
+//! paths, disjointness, dangling ends, patch disks, patch valences, Euler characteristic,
 //! connectivity, high-valence warnings. Lists at most kMaxListedIssuesPerCode issues per code
 //! (the first ones found), each further one counted in a summary entry at the end.
 //! Never throws for bad layouts.

@@ -1,6 +1,6 @@
 // GeometryCache: per-face frames, normals, areas, corner angles, angle defects, and the
-// discrete connection κ on dual edges (algorithm.md §1.3). Built once per mesh state and
-// passed down; never rebuilt inside loops.
+// discrete connection κ on dual edges (docs/design.md, "Field topology"). Built once per mesh
+// state and passed down; never rebuilt inside loops.
 #pragma once
 
 #include <array>
@@ -65,7 +65,8 @@ struct GeometryCache {
 GeometryCache build_geometry(const TriMesh& mesh);
 
 //! Recomputes the geometric part after vertices moved, keeping the frames' choice of edge and
-//! continuing κ (κ_new = κ_old + wrap(κ_new − κ_old), never re-wrapped; algorithm.md §6.1).
+//! continuing κ (κ_new = κ_old + wrap(κ_new − κ_old), never re-wrapped; docs/design.md,
+//! "Continuing κ").
 //! When few vertices moved since the last computation, only their faces, the vertices and
 //! edges of those faces are recomputed; the result is bit-identical to the full computation,
 //! except that κ of the other edges keeps its value (the full pass re-continues it, which can

@@ -1,5 +1,5 @@
 // Straightest geodesics on a triangle mesh [PS98] and the node-Voronoi safeguard
-// (paper §6.1.1, §7.2; algorithm.md §6.3).
+// (paper §6.1.1, §7.2; docs/design.md, "Straightest geodesics").
 #pragma once
 
 #include <functional>
@@ -23,7 +23,7 @@ struct GeodesicTrace {
 //! direction \p direction (projected into the start face; at a vertex start, into the incident
 //! face whose corner wedge contains it). Inside a face the path is straight; at an edge the next
 //! face is unfolded; through a vertex it leaves into the wedge containing the projected
-//! direction (the simpler rule of algorithm.md §6.3). It stops at the boundary, and before
+//! direction (docs/design.md, "Straightest geodesics"). It stops at the boundary, and before
 //! entering a face for which \p blocked_face returns true (the point is then on the shared
 //! edge or vertex).
 //! \pre start.face is a valid face with barycentrics in [0, 1] summing to 1; length ≥ 0.

@@ -10,8 +10,8 @@ namespace qs {
 
 namespace {
 
-// ∂E_t/∂x of one face's term of (1) for its corner k (algorithm.md §6.1), as a 3D vector in the
-// face plane. The face's 2D frame is (r_f, n_f × r_f), as in the parameterization.
+// ∂E_t/∂x of one face's term of (1) for its corner k (docs/design.md, "Gradient"), as a 3D
+// vector in the face plane. The face's 2D frame is (r_f, n_f × r_f), as in the parameterization.
 Vec3 face_corner_gradient(const TriMesh& mesh, const GeometryCache& g, double theta,
                           const std::vector<std::array<double, 2>>& uv, double aniso, double weight,
                           double target_scale, int f, int k) {

@@ -1,4 +1,4 @@
-// Node gradients of the residual E of energy (1) (paper §7, algorithm.md §6.1 and §9):
+// Node gradients of the residual E of energy (1) (paper §7; docs/design.md, "Gradient"):
 // the 1-ring estimator (exact with the field frozen, by the envelope theorem) and central
 // finite differences that re-solve field and parameterization.
 #pragma once
@@ -22,8 +22,8 @@ Vec3 vertex_normal(const TriMesh& mesh, const GeometryCache& geometry, int verte
 void tangent_basis(const Vec3& n, Vec3& t1, Vec3& t2);
 
 //! ∂E/∂x_v of energy (1) at vertex \p vertex with the field and the parameterization held
-//! fixed (algorithm.md §6.1): the 1-ring sum of per-face analytic gradients (anisotropic norm
-//! and ParamOptions::face_weights included), each with the field frozen relative to the edge
+//! fixed (docs/design.md, "Gradient"): the 1-ring sum of per-face analytic gradients (anisotropic
+//! norm and ParamOptions::face_weights included), each with the field frozen relative to the edge
 //! opposite the vertex, projected onto the tangent plane of the area-weighted vertex normal.
 //! With sizing the targets are e^{s_t} u_t, e^{s_t} v_t, s_t held fixed per face like the field
 //! (\p log_scale: Parameterization::sizing_log_scale, size #F, or empty for s = 0).

@@ -1,7 +1,7 @@
 // Node optimization by gradient descent on the residual E of energy (1) (paper §6.1, §7;
-// algorithm.md §6): alternating (A) field + parameterization solves with fixed nodes and
-// (B) a step of all unpinned nodes along −∇E, traced as straightest geodesics and realized by
-// relocating one mesh vertex per node; steps that raise E are undone and α halved.
+// docs/design.md, "Node optimization"): alternating (A) field + parameterization solves with fixed
+// nodes and (B) a step of all unpinned nodes along −∇E, traced as straightest geodesics and
+// realized by relocating one mesh vertex per node; steps that raise E are undone and α halved.
 #pragma once
 
 #include <array>
@@ -23,28 +23,24 @@ namespace qs {
 
 enum class GradientMethod { Estimator, Exact };
 
+//! Settings of the node optimization (docs/design.md, "Node optimization"). Lengths relative to
+//! the mean edge length unless stated; angles in degrees where the name says so.
 struct NodeOptOptions {
+  // ---- descent (docs/design.md, "Step length") ----
   //! Descent steps (accepted + rejected) before the first hop sweep; a sweep that moves nodes
   //! extends the budget to at least hop_descent_steps more.
   int max_steps = 25;
   int max_halvings = 5;  //!< a descent phase ends after this many halvings of α
   double alpha = 0.75;   //!< damping factor α of the step length
-  //! A descent phase also ends (like one whose budget is used up: the hop sweep follows) after
-  //! stall_steps accepted steps in a row that each lowered E by less than stall_gain (relative);
-  //! ≤ 0: off (the paper's rule: the budget, max_halvings or convergence). Off by default. The
-  //! descent approaches its optimum geometrically: on the 8-node ellipsoid layouts the last
-  //! 10 steps of the first phase gained 0.1 % together before the hop sweep lowered E by
-  //! 6–10 %, and 1e-3 reached the discrete baseline's E 7.8–11.6× faster than that baseline
-  //! instead of 4.6–7.4× (qs_relocation_bench --stall-gain). But on the 70K bunny the earlier
-  //! sweeps ended in a state with a node whose parameterization winds wrongly (cone 0° instead
-  //! of 360°), where the orientation constraints are infeasible: 269 (1e-3) and 281 (1e-4)
-  //! fold-overs remained instead of 0.
+  //! A descent phase also ends (as when its budget is used up: the hop sweep follows) after
+  //! stall_steps accepted steps in a row that each lowered E by less than stall_gain (relative).
+  //! ≤ 0: off, the paper's rule (the budget, max_halvings or convergence). Off by default:
+  //! ending phases early can leave states whose orientation constraints are infeasible.
   double stall_gain = 0;
   int stall_steps = 2;
   //! After a sweep with hops the descent restarts at min(alpha, hop_alpha_growth × the α of the
-  //! phase's last accepted step) instead of alpha (≤ 0: at alpha). The hops change E where
-  //! the nodes sit, not the step sizes that fit: restarted at 0.75 the 8-node cases rejected
-  //! the three steps at 0.75, 0.375 and 0.19 after every sweep and accepted the fourth.
+  //! phase's last accepted step) instead of alpha (≤ 0: at alpha), since hops change where the
+  //! nodes sit, not the step sizes that fit.
   double hop_alpha_growth = 2.0;
   //! Step length l = α · scale · ‖d‖: ⅔ for the estimator, 1 for the exact gradient (paper §7.2).
   double estimator_scale = 2.0 / 3.0;
@@ -54,27 +50,16 @@ struct NodeOptOptions {
   bool voronoi_safeguard = true;  //!< limit each trace to the node's Dijkstra-Voronoi cell
   //! A moving node is never carried to a vertex next to another node (the other node's vertex
   //! or its 1-ring, next_to_other_nodes; a node already there may stay), in descent steps,
-  //! curve slides and hop sweeps: two nodes on one triangle leave the patches or the arc
-  //! between them narrower than a triangle, where the orientation constraints become
-  //! infeasible. On the pig of `import-quads --refine 3` (942 nodes, about 5 edges per patch
-  //! side) one descent step without it put 118 node pairs on a common edge, and the fold-over
-  //! removal fell back to the initial state (E 2.048); with it the optimized layout embeds: 0
-  //! fold-overs, structurally equivalent, E 1.578 (session 27). Off by default: on spot imported
-  //! onto itself (about 3 edges per patch side) and displaced two rings it left 31 fold-overs
-  //! where the default ends with none (`optimize --keep-nodes-apart`); with the crowded nodes
-  //! moved apart first (separate_crowded_nodes) it embeds, but at E 1.834 against the
-  //! default's 1.709. `quadsketch-cli optimize`
-  //! runs again with it when a run keeps fold-overs or falls back to an earlier state
-  //! (cmd_optimize.cpp, the keep-apart retry).
+  //! curve slides and hop sweeps. Two nodes on one triangle leave the patches or the arc between
+  //! them narrower than a triangle, where the orientation constraints become infeasible; this
+  //! matters for dense layouts with a few edges per patch side. Off by default (it can also end
+  //! higher or folded); `quadsketch-cli optimize` runs again with it when a run keeps
+  //! fold-overs or falls back to an earlier state (core/nodeopt/retry.h).
   bool keep_nodes_apart = false;
   //! Nodes that already sit next to another node (on its 1-ring, as a displaced sketch puts
   //! them) are first moved apart (core/layout/perturb.h separate_nodes); the optimization then
   //! starts from that layout (E_init, the initial fallback). keep_nodes_apart only keeps nodes
-  //! from getting there. Off by default: on spot imported onto itself and displaced two rings
-  //! (206 of 370 nodes crowded, 86 moved apart) it lets the run with nodes kept apart embed
-  //! its final state (E 1.834) where that run otherwise falls back to its initial state, but on
-  //! the rocker-arm cage layout (`cage-layout --simplify`) the run with nodes kept apart ends at
-  //! E 0.693 with it against 0.557 without (session 29).
+  //! from getting there. Off by default (`optimize --separate-nodes`).
   bool separate_crowded_nodes = false;
   //! Nodes whose step is shorter than this fraction of the mean edge length do not move; when
   //! no node moves the descent has converged.
@@ -91,61 +76,51 @@ struct NodeOptOptions {
   bool slide_on_curves = true;
   double curve_corner_deg = 30.0;
   //! The sharp edges (at the field's sharp angle) count as feature curves too: nodes on them
-  //! slide along them, and no node relocates a vertex on them (they keep their shape), as the
-  //! paper does for the feature curves in use. Off by default: on organic meshes coarse
-  //! tessellation makes many edges "sharp" (spot: 54 nodes on them, E 1.50 → 2.28); on fandisk
-  //! the sharp edges keep their shape (705 before, 704 after, instead of 802 with chamfers) at
-  //! E 11.4 instead of 6.1.
+  //! slide along them, and no node relocates a vertex on them, so they keep their shape at a
+  //! higher E. Off by default: on coarse organic meshes many edges count as sharp.
   bool sharp_edges_as_curves = false;
   //! When a step raises E and some nodes changed their vertex in it, retry the step once with
   //! those nodes kept on their vertices before halving α (the switch itself can raise E).
   bool retry_without_switches = true;
   //! A trial whose switches are mostly (at least `switch_tabu_overlap` of them: the same node
   //! to the same vertex) those of the last trial rejected at the current α is rejected without
-  //! a solve and the retry without switches follows. At an unchanged α the descent proposes
-  //! nearly the same switches again after a retry was accepted, and they raise E again: on the
-  //! 70K bunny one re-layout (E 0.0693 → 0.0794) was evaluated six steps in a row. With it,
-  //! the bunny's 25 steps take 10.9 instead of 17.7 s CPU and end at E 0.0405 instead of 0.0418
-  //! (at 0.75 the trajectory is unchanged: 12.8 s); spot ends as before.
+  //! a solve, and the retry without switches follows: at an unchanged α the descent would
+  //! otherwise propose and solve the same rejected switches again.
   bool switch_tabu = true;
   double switch_tabu_overlap = 0.5;
   //! A sliding node (slide_on_curves) whose vertex switch made a trial raise E takes half steps
   //! from then on (until a switch of its own is accepted or a hop sweep starts a new phase),
-  //! also when the retry without switches is accepted and α stays. A node sliding along the
-  //! boundary and the interior node it lines up with otherwise step past each other and propose
-  //! the same swap at every step (a 2×2 grid layout with a displaced boundary node stalled at
-  //! E 2.6 instead of 0). Interior nodes keep the plain rule: the same damping for them ended
-  //! above 1.05·E* on one of the recovery cases.
+  //! also when the retry without switches is accepted and α stays. Otherwise a node sliding
+  //! along the boundary and an interior node lined up with it can step past each other and
+  //! propose the same swap at every step. Interior nodes keep the plain rule.
   bool damp_rejected_slides = true;
+
+  // ---- work reuse and threads (same results either way) ----
   //! A trial with switches is solved on a second thread while this one solves its retry
   //! without switches (a re-solve of the current Pipeline), when the machine reports two
   //! hardware threads and reuse_field is on: the retry is ready when the re-layout is rejected.
-  //! Same results as the sequential order, more CPU (the retry is also solved when the
-  //! re-layout is accepted). Off by default: on the 2-vCPU test machine the 70K bunny's 25
-  //! steps took 8.7 s wall with it and 8.4 s without (the two solves slow each other down).
+  //! Same results as the sequential order, more CPU. Off by default: on two cores the two
+  //! solves slow each other down.
   bool parallel_retry = false;
   //! A trial in which nodes change their vertex (re-routed arcs), and a hop evaluation,
   //! continues the current Pipeline (Pipeline(mesh, layout, previous)): a copy of its field
   //! solver re-solved for the new layout by CrossFieldSolver::update_layout, which collects the
   //! constraints of the trial's (relocated) geometry again (curvature updated around moved
   //! vertices) and keeps the factorizations' analyses, so the field is a fresh Pipeline's up to
-  //! solver round-off (tests/reuse_test.cpp). false: a fresh Pipeline per such trial (curvature,
-  //! constraints, every analysis and factorization redone). On the 70K bunny the continued
-  //! trials give the same 25-step trajectory and E as fresh ones at about 15 % less CPU (the
-  //! constraint set changes in every trial there, so each refactorizes); on spot (imported onto
-  //! itself) both end at E 1.496 with 0 fold-overs.
-  //! `optimize --integer` turns it off (nodes on shared iso-lines, see cmd_optimize.cpp).
+  //! solver round-off. false: a fresh Pipeline per such trial (curvature, constraints, every
+  //! analysis and factorization redone). `optimize --integer` turns it off (nodes on shared
+  //! iso-lines).
   bool reuse_field = true;
   //! The parameterizations of the trials take their fill-reducing ordering from one nested
   //! dissection of the mesh's vertex graph (ParamOptions::vertex_order) instead of an AMD
   //! ordering of every new reduced matrix. On meshes where the initial Pipeline computes it
   //! beside the field (PipelineOptions::order_vertices) the initial solve uses it too; on
   //! smaller ones it is computed beside the initial solve, which keeps AMD. false also turns
-  //! PipelineOptions::order_vertices off. Bunny (70K faces, 150 patches): the analysis of a
-  //! re-layout takes about half the time and each factorization about 20 % less
-  //! (docs/benchmarks.md, session 22). Without effect when the given PipelineOptions already
+  //! PipelineOptions::order_vertices off. Without effect when the given PipelineOptions already
   //! carry a vertex order.
   bool vertex_ordering = true;
+
+  // ---- hop polish (docs/design.md, "Hop polish") ----
   //! Polish by discrete hops (discrete.h hop_sweep) when the descent ends (no node moves, more
   //! than max_halvings halvings, or the step budget is used up): the descent can stop in a local
   //! optimum of E for the node carried by its current (relocated) vertex, which a hop to a
@@ -157,15 +132,13 @@ struct NodeOptOptions {
   //! together, e.g. a rotated cube layout on a sphere) are not left this way.
   //! Without sharp cone vertices (hop_cones_first then does nothing) the first descent phase is
   //! the same with or without the polish, so it never ends higher.
-  //! Callers that drive the descent one step per call (max_steps = 1, the editor) turn it off:
-  //! a sweep extends the call by hop_descent_steps.
+  //! Callers that drive the descent one step per call (max_steps = 1) turn it off: a sweep
+  //! extends the call by hop_descent_steps.
   bool hop_polish = true;
   int max_hop_rounds = 3;      //!< hop sweeps at most (each after a converged descent)
   int hop_descent_steps = 10;  //!< descent steps available at least after a sweep with hops
   //! Only nodes whose vertex is relocated at least this fraction of the mean edge length off
-  //! its original position try to hop to a neighbour (0: every relocated node; 0.25 before
-  //! session 5 left nodes 0.1–0.25 edges off untried that a hop improves, e.g. on the cube
-  //! layout of the k = 12 ellipsoid: 0.50 → 0.44).
+  //! its original position try to hop to a neighbour (0: every relocated node).
   double hop_min_offset = 0;
   int hop_candidates = 2;    //!< neighbours tried per node (best aligned first)
   double hop_min_cos = 0.0;  //!< only neighbours within 90° of the relocation direction
@@ -173,7 +146,7 @@ struct NodeOptOptions {
   //! (largest relocation) try first.
   int hop_max_evaluations = 64;
   //! The neighbour hops stop after this many solves in a row without a lower E (≤ 0: no
-  //! limit): on large models most of the budget would otherwise be spent without gain.
+  //! limit), so that large models do not spend the budget without gain.
   int hop_max_failures = 16;
   //! A node's hop candidates are solved two at a time, one on a second thread
   //! (hop_sweep's jobs), when the machine reports two hardware threads. Each candidate's
@@ -206,31 +179,31 @@ struct NodeOptOptions {
   int hop_cone_max_evaluations = 64;  //!< per sweep for each of the two cone passes
   int hop_cone_max_failures = 8;      //!< as hop_max_failures, for each cone pass
   //! Also one sweep of the collective and cone passes before the descent (when some node has a
-  //! cone candidate; not counted in max_hop_rounds): nodes displaced from sharp corners return
-  //! before the descent drags their neighbours along (genus-2 polycube, 1 ring, seed 2: E 0.76
-  //! → 7e-23 in 0.24 s CPU, the discrete baseline's E in 17 s).
+  //! cone candidate; not counted in max_hop_rounds), so that nodes displaced from sharp corners
+  //! return before the descent drags their neighbours along.
   bool hop_cones_first = true;
-  //! Fold-over removal after the descent: a last solve with strict orientation constraints
-  //! (algorithm.md §7.2, core/param/orientation.h) when fold-overs remain; `enabled` inside
-  //! `orientation` is set by the optimizer (CLI: --no-orientation clears orientation_at_end).
+
+  // ---- fold-over removal (docs/design.md, "Fold-over removal") ----
+  //! A last solve with strict orientation constraints (docs/design.md, "Orientation
+  //! constraints"; core/param/orientation.h) when fold-overs remain after the descent; `enabled`
+  //! inside `orientation` is set by the optimizer (CLI: --no-orientation clears
+  //! orientation_at_end).
   bool orientation_at_end = true;
   OrientationOptions orientation;
   //! The last fallback of the fold-over removal (with orientation_at_end): when fold-overs
   //! remain at the final state and at the earlier states tried (before the polish, the fewest
   //! fold-overs), the initial state gets the orientation constraints too and is returned when
   //! it ends with fewer fold-overs (NodeOptResult::initial_reverted): a layout that embeds where
-  //! the user put its nodes is not handed back folded. The exact cow (`import-quads --refine
-  //! 3`) kept 121 fold-overs after stiffening at E 2.19; its initial state embeds at E 3.62.
+  //! the user put its nodes is not handed back folded.
   bool initial_fallback = true;
-  //! Diagnostics and the fallback's tests: false skips the orientation-constrained solve at
+  //! For diagnostics and the fallback's tests: false skips the orientation-constrained solve at
   //! every state whose nodes or vertices moved (the final state, before the polish, the fewest
   //! fold-overs), as if it had left their fold-overs, so that only the initial state's solve
-  //! (initial_fallback) can remove them: whether the sketch itself embeds, and the fallback
-  //! chain on any input (real cases that need it depend on the descent's rounding: the
-  //! displaced spot with nodes kept apart did on an AMD EPYC, not on an Intel Xeon). Stiffening
-  //! still runs where fold-overs remain.
+  //! (initial_fallback) can remove them. This shows whether the sketch itself embeds, and
+  //! exercises the fallback chain on any input and CPU. Stiffening still runs where fold-overs
+  //! remain.
   bool orientation_at_moved_states = true;
-  bool stiffen_at_end = true;  //!< stiffening (§7.1) when fold-overs remain after that
+  bool stiffen_at_end = true;  //!< stiffening when fold-overs remain after that
   StiffeningOptions stiffening;
   //! Ends the node movement early when it returns true (a time limit): polled before each
   //! descent step and hop sweep and before each candidate solve inside a sweep. The state

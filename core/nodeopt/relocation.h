@@ -1,5 +1,5 @@
 // Continuous node positioning by vertex relocation and re-routing of a moved node's arcs
-// (paper §6.1.1, algorithm.md §6.4).
+// (paper §6.1.1; docs/design.md, "Node relocation").
 #pragma once
 
 #include <functional>
@@ -119,9 +119,7 @@ bool occupied_by_layout(const Layout& layout, int node_index, const LayoutObstac
 //! their 1-rings. A node carried to such a vertex would share a triangle (or an edge) with the
 //! other node: the two patches or the arc between them would be narrower than one triangle,
 //! where the parameterization cannot keep the layout's sides apart, and the orientation
-//! constraints become infeasible (the 942-node pig of `import-quads --refine 3`: one descent
-//! step put 118 node pairs on a common edge, and no later state embedded). A node already there
-//! may stay.
+//! constraints become infeasible. A node already there may stay.
 std::vector<char> next_to_other_nodes(const TriMesh& mesh, const Layout& layout, int node_index);
 //! One entry of forbidden_relocation_vertices for node \p node_index, vertex \p v, from
 //! \p obstacles (make_layout_obstacles of \p layout) without building the #V array (a descent

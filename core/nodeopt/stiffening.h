@@ -1,4 +1,4 @@
-// Stiffening (paper §6, algorithm.md §7.1; after libigl miq.cpp): raise per-face weights where
+// Stiffening (paper §6; docs/design.md, "Stiffening"): raise per-face weights where
 // the parameterization is flipped or distorted, and re-solve, to remove fold-overs.
 #pragma once
 

@@ -1,5 +1,5 @@
 // Linear equality constraints and their exact elimination by sparse Gaussian elimination
-// (algorithm.md §4.6): x = Z y + z0, so the reduced energy stays SPD for CHOLMOD.
+// (docs/design.md, "Solving"): x = Z y + z0, so the reduced energy stays SPD for CHOLMOD.
 #pragma once
 
 #include <Eigen/Sparse>

@@ -1,4 +1,5 @@
-// Cut graph and per-wedge variables of the seamless parameterization (algorithm.md §4.1–4.3).
+// Cut graph and per-wedge variables of the seamless parameterization (docs/design.md,
+// "Transitions and cut graph").
 #pragma once
 
 #include <array>

@@ -1,5 +1,6 @@
 // Arc strips, transitions along arcs and the consistent u/v labelling of half-arcs by
-// direction symbols (paper §4.5 (4)(5), algorithm.md §1.1, §4.5).
+// direction symbols (paper (4)(5); docs/design.md, "Layout model" and "Node connections and
+// labels").
 #pragma once
 
 #include <vector>

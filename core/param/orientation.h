@@ -1,7 +1,7 @@
 // Strict orientation constraints for the parameterization (paper §6.3 "Limitations of Node
-// Movement", algorithm.md §7.2): linear tri-sector constraints [BCE*13] on the faces that fold,
-// solved as a convex QP in the reduced unknowns by a primal-dual interior-point method whose
-// Newton systems are factorized by CHOLMOD (no extra dependency).
+// Movement"; docs/design.md, "Orientation constraints"): linear tri-sector constraints [BCE*13] on
+// the faces that fold, solved as a convex QP in the reduced unknowns by a primal-dual
+// interior-point method whose Newton systems are factorized by CHOLMOD (no extra dependency).
 //
 // Problem. The parameterization solve eliminates every equality constraint exactly:
 // x = Z·y + z0 (x: 2 values (u, v) per wedge, y: the free unknowns), and minimizes
@@ -48,11 +48,8 @@
 // sectors sit nearer to where the solution puts the corners while keeping the field's winding
 // around every vertex. Where the layout makes the map turn away from the field (arcs that leave
 // the field's directions near crowded nodes), field-frame sectors ask each face to turn back,
-// which together with the iso-line constraints can be infeasible: spot's displaced imported
-// layout (perturb --rings 2 --seed 1, no sizing) ends with 4 fold-overs with field-frame sectors
-// and 0 with solution-frame ones. Neither frame's feasible set contains the other's (inspired_
-// mesh's coarsened layout with split constraint clusters: infeasible in the solution frame, 0
-// fold-overs in the field frame), so by default the field frame is solved first and, only where
+// which together with the iso-line constraints can be infeasible. Neither frame's feasible set
+// contains the other's, so by default the field frame is solved first and, only where
 // fold-overs remain, the solution frame as well; the solution with fewer fold-overs is kept and
 // the report's counts and time cover both attempts.
 //
@@ -77,7 +74,7 @@ namespace qs {
 
 //! Which frame the tri-sector rays are built in (see "Sector frame" above).
 enum class SectorFrame {
-  kField,     //!< the field frame (u_t, v_t) of each face (algorithm.md §7.2 as written)
+  kField,     //!< the field frame (u_t, v_t) of each face
   kSolution,  //!< the field frame turned by the unconstrained solution's rotation on the face
   kFieldThenSolution,  //!< kField; where fold-overs remain, kSolution too; fewer fold-overs kept
 };
@@ -103,22 +100,18 @@ struct OrientationOptions {
   //! their set, the next round constrains every face instead of growing the set (0: never).
   //! The primal solver factorizes a matrix of A's size in each iteration however many rows
   //! there are, and on large models growing rounds keep finding new fold-overs just outside
-  //! the set: on the 70K bunny after 25 descent steps (897 fold-overs) rings-2 rounds left 21
-  //! fold-overs after 5 rounds and 89 iterations (11 s); every face constrained at once, 0 in
-  //! 24 iterations (4 s), E 0.0506 either way. But the constraints also bind faces that would
-  //! not fold: on spot (18 fold-overs after the descent, E 1.453) every face gives E 1.520
-  //! where two growing rounds (334 faces) give 1.496, hence not after the first round. If the
-  //! all-faces round is infeasible (the constraints are only sufficient for orientation), the
-  //! growing rounds go on.
+  //! the set. Constraining every face also binds faces that would not fold (a higher E), hence
+  //! not after the first round. If the all-faces round is infeasible (the constraints are only
+  //! sufficient for orientation), the growing rounds go on.
   int all_faces_after_rounds = 2;
   //! When the all-faces round is infeasible, stop there with the best earlier round instead of
   //! growing the set further. The node optimizer sets it where it has an earlier state to fall
-  //! back to: the further rounds rarely remove every fold-over there (the 70K bunny after the
-  //! hop polish: 147 left after 5 rounds, 15 s), and the earlier state's solve decides anyway.
+  //! back to: the further rounds rarely remove every fold-over there, and the earlier state's
+  //! solve decides anyway.
   bool stop_if_all_faces_infeasible = false;
   //! Polled before every round and every interior-point iteration (throws qs::Cancelled when it
-  //! asks to cancel): one solve can run for seconds on large models (the 70K bunny: 11 s in
-  //! 3 rounds). Not owned; must outlive the solve; nullptr: never cancelled.
+  //! asks to cancel): one solve can run for seconds on large models. Not owned; must outlive the
+  //! solve; nullptr: never cancelled.
   const Observer* observer = nullptr;
   //! Where fold-overs remain after the QP (or it is infeasible), minimize the untangling
   //! energy of untangle.h from the better of the two solutions; kept when it has fewer

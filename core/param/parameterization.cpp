@@ -615,8 +615,8 @@ const Parameterization& ParamSolver::solve(const TriMesh& mesh, const GeometryCa
   result_.orientation = {};
   if (options_.orientation.enabled &&
       count_foldovers(cut_.corner_wedge, Z * y + reduction_.z0) > 0) {
-    // Strict orientation constraints (algorithm.md §7.2); when they fail, the unconstrained
-    // solution stays and the report says why.
+    // Strict orientation constraints (docs/design.md, "Orientation constraints"); when they
+    // fail, the unconstrained solution stays and the report says why.
     OrientationReport& rep = result_.orientation;
     try {
       // The normal matrices of its sparse rounds hold A's pattern and face couplings: the vertex

@@ -1,6 +1,7 @@
-// Global seamless parameterization whose base complex realizes the layout (paper §5,
-// algorithm.md §4): energy (1) with anisotropic norm, node-connection constraints (3),
-// iso-line constraints for boundary/pinned arcs and feature edges, all eliminated exactly.
+// Global seamless parameterization whose base complex realizes the layout (paper §5;
+// docs/design.md, "Parameterization"): energy (1) with anisotropic norm, node-connection
+// constraints (3), iso-line constraints for boundary/pinned arcs and feature edges, all eliminated
+// exactly.
 #pragma once
 
 #include <array>
@@ -30,24 +31,24 @@ struct ParamOptions {
   //! Anisotropic norm (BZK09): misalignment is penalised `anisotropy` times more than scale.
   bool anisotropic = true;
   double anisotropy = 10.0;
-  //! Per-face weights w_t multiplying each face's term of (1) (stiffening, algorithm.md §7.1).
+  //! Per-face weights w_t multiplying each face's term of (1) (docs/design.md, "Stiffening").
   //! Empty (the default) means all 1; otherwise size #F, every entry > 0.
   std::vector<double> face_weights;
-  //! Tri-sector orientation constraints when the solve has fold-overs (algorithm.md §7.2).
+  //! Tri-sector orientation constraints when the solve has fold-overs (docs/design.md,
+  //! "Orientation constraints").
   OrientationOptions orientation;
   //! Fixed arc lengths (integer patch sizes, paper §8): one linear row per listed arc, added to
   //! the node-connection constraints. Arcs not in the layout or dangling are ignored. Lengths
   //! that contradict each other (e.g. two opposite patch sides with different values) make the
   //! constraint set incompatible (InvalidInputError naming the arcs).
   std::vector<ArcLength> arc_lengths;
-  //! Curl-reducing sizing field (paper §5.3, algorithm.md §4.4, core/param/sizing.h): the
+  //! Curl-reducing sizing field (paper §5.3, docs/design.md "Sizing field", sizing.h): the
   //! targets become e^{s_t} u_t, e^{s_t} v_t, with s recomputed from the field at every solve.
   SizingOptions sizing;
   //! Fill-reducing ordering of the reduced matrix from AMD on the wedge graph (one node per
   //! wedge's u, v unknowns; grouped_amd_ordering) instead of CHOLMOD's AMD on the full matrix.
-  //! The analysis costs about a third less (bunny 70K faces: 0.050 → 0.035 s CPU), but nnz(L)
-  //! was higher on three of four meshes tried (bunny +5 %, joint +10 %, bunny with another
-  //! layout +13 %; spot −1 %) and the factorization up to 5 % slower, so it is off.
+  //! The analysis is cheaper, but the factor usually has more fill, so it is off
+  //! (docs/benchmarks.md, "Design measurements").
   bool wedge_ordering = false;
   //! A fill-reducing order of the mesh's vertices (vertex_nested_dissection: entry k is the
   //! vertex eliminated k-th, size #V), or null. When set, a new reduced matrix's symbolic
@@ -55,9 +56,7 @@ struct ParamOptions {
   //! translations and the long columns of merged unknowns last) instead of AMD on the matrix.
   //! The vertex order does not depend on the layout: a Pipeline computes it once for all its
   //! solvers and the pipelines continued from it (PipelineOptions::order_vertices), as does the
-  //! node optimizer on smaller meshes (NodeOptOptions::vertex_ordering). Bunny, 70K faces, 150
-  //! patches: flops of a factorization −38 %, its time −20 %, the analysis −50 %; on the joint
-  //! (3751 nodes) nnz(L) +8 % (docs/benchmarks.md, session 22). Takes precedence over
+  //! node optimizer on smaller meshes (NodeOptOptions::vertex_ordering). Takes precedence over
   //! wedge_ordering.
   std::shared_ptr<const std::vector<int>> vertex_order;
   //! Runs independent parts of the stage on a second thread: the layout labels beside the cut

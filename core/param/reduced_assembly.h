@@ -1,5 +1,5 @@
 // Assembly of the energy matrix H on the wedge unknowns and of the reduced matrix A = ZᵀHZ on
-// fixed sparsity patterns (algorithm.md §4.4, §4.6). The patterns are built once per
+// fixed sparsity patterns (docs/design.md, "Energy" and "Solving"). The patterns are built once per
 // constraint elimination; every later assembly (new geometry, new field) scatters per-face
 // blocks into H's values and fills A's values in place, with no triplet sorting, no sparse
 // temporaries and no change of A's pattern, so CHOLMOD's symbolic analysis is reused

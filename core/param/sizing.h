@@ -1,5 +1,5 @@
-// Curl-reducing sizing field (paper §5.3 after [RLL*06], algorithm.md §4.4): a per-face
-// log-scale s_t such that the scaled cross field e^{s} û, e^{s} v̂ is as close to curl-free
+// Curl-reducing sizing field (paper §5.3 after [RLL*06]; docs/design.md, "Sizing field"): a
+// per-face log-scale s_t such that the scaled cross field e^{s} û, e^{s} v̂ is as close to curl-free
 // (integrable, i.e. the gradient of a parameterization) as a scalar scale can make it. The
 // parameterization then aims at ∇u = e^{s_t} u_t, ∇v = e^{s_t} v_t instead of the unit targets.
 //
@@ -43,12 +43,10 @@
 namespace qs {
 
 struct SizingOptions {
-  //! Scale the parameterization's targets by e^{s_t} (ParamOptions::sizing). Off by default,
-  //! for the node optimization: with fixed nodes it lowers the residual E (same target norm) on
-  //! every shared model measured (spot, fandisk, joint, the ellipsoid, the mask), but with it the
-  //! descent from displaced layouts ends above issue #5's 1.05 E* on 5 of the 9 asserted
-  //! icosphere recoveries (up to 1.33 E*), and 25 steps on the 70K bunny take 9.7–9.9 s instead
-  //! of 6.2–6.4 s (docs/benchmarks.md, sessions 3 and 24). `optimize --sizing` enables it.
+  //! Scale the parameterization's targets by e^{s_t} (ParamOptions::sizing). Off by default:
+  //! with fixed nodes it lowers the residual E, but the node optimization recovers displaced
+  //! layouts less closely and more slowly with it (docs/benchmarks.md, "Design measurements").
+  //! `optimize --sizing` enables it.
   bool enabled = false;
   //! |s_t| ≤ clamp (a factor e^{±clamp} on the target length). Finite and ≥ 0.
   double clamp = 2.0;
@@ -60,8 +58,8 @@ struct SizingOptions {
   std::vector<double> frozen_log_scale;
 };
 
-//! Per-face discrete curls of the matched field directions û and v̂ (algorithm.md §4.4),
-//! optionally of the scaled field e^{s} û, e^{s} v̂. Units: 1/length.
+//! Per-face discrete curls of the matched field directions û and v̂ (docs/design.md, "Sizing
+//! field"), optionally of the scaled field e^{s} û, e^{s} v̂. Units: 1/length.
 struct FieldCurl {
   std::vector<double> u, v;  //!< size #F each
 };

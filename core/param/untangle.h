@@ -3,9 +3,8 @@
 // every equality constraint (seams, node connections, iso-lines) stays exact.
 //
 // The tri-sector constraints of orientation.h are a convex *inner* approximation of "every
-// face positively oriented": when they are infeasible a fold-free map may still exist (the
-// displaced pig, perturb --rings 2 on about 5-edge patch sides: the QP is infeasible in both
-// sector frames, this reaches 0 fold-overs). It minimizes, for a decreasing sequence of ε > 0,
+// face positively oriented": when they are infeasible a fold-free map may still exist. It
+// minimizes, for a decreasing sequence of ε > 0,
 //
 //   Φ_ε(y) = q(y) / q_scale + β · Σ_t a_t · F_ε(J_t),
 //   F_ε(J) = ((1 − λ)·|J|²_F + λ·(D² + D0²)/D0) / χ(D, ε),   D = det J,
@@ -17,14 +16,13 @@
 // for D ≫ ε, F_ε is the conformal distortion |J|²/D (≥ 2) and the area distortion D/D0 + D0/D
 // (≥ 2) mixed; for D ≤ 0 it grows like |D|/ε², so as ε shrinks folded faces are pushed to
 // positive area, while q keeps the map aligned with the field. The area term stops a face from
-// escaping the barrier by collapsing (J → 0), which the conformal term alone allows (tried: the
-// displaced pig stalled at 995 faces of zero area). This is the regularized untangling of
-// Garanzha, Kaporin, Kudryavtseva, Protais, Ray and Sokolov ("Foldover-free maps in 50 lines
-// of code", 2021) with the field-aligned energy added, written from the paper's formulas,
-// including its rule for the next ε (from the barrier's relative decrease σ ≥ min_sigma and
-// the smallest determinant). Each Newton step factorizes q's matrix plus the per-face Hessians
-// projected onto positive semidefinite ones (eigenvalues clamped), by CHOLMOD with one symbolic
-// analysis for the whole run, and a backtracking line search on Φ_ε follows.
+// escaping the barrier by collapsing (J → 0), which the conformal term alone allows. This is the
+// regularized untangling of Garanzha, Kaporin, Kudryavtseva, Protais, Ray and Sokolov
+// ("Foldover-free maps in 50 lines of code", 2021) with the field-aligned energy added, written
+// from the paper's formulas, including its rule for the next ε (from the barrier's relative
+// decrease σ ≥ min_sigma and the smallest determinant). Each Newton step factorizes q's matrix plus
+// the per-face Hessians projected onto positive semidefinite ones (eigenvalues clamped), by CHOLMOD
+// with one symbolic analysis for the whole run, and a backtracking line search on Φ_ε follows.
 //
 // The map is returned as soon as it has no fold-over; otherwise the iterate with the fewest
 // fold-overs (ties: the lowest q) is returned when the ε rule or the step budget runs out.
@@ -46,15 +44,13 @@ struct UntangleOptions {
   double area_weight = 0.5;
   double initial_epsilon = 1.0;  //!< ε of the first round, relative to D0
   double min_epsilon = 1e-8;     //!< lower bound of ε, relative to D0
-  //! σ ≥ min_sigma in the ε rule (0.1 in Garanzha et al.; 0.5 let ε collapse on the displaced
-  //! pig while faces were still folded)
+  //! σ ≥ min_sigma in the ε rule (0.1 in Garanzha et al.; larger values let ε shrink while
+  //! faces are still folded)
   double min_sigma = 0.2;
   //! Newton steps per ε at most (a round also ends when Φ_ε stops decreasing). Too few let ε
-  //! shrink faster than the folded faces open: 2 left 10 of a folded grid's faces folded (the
-  //! test) where 5 unfold it; 20 used the whole budget on the displaced pig (13 left).
+  //! shrink faster than the folded faces open; too many spend the budget on early rounds.
   int newton_per_round = 5;
-  //! Newton steps in all at most (one factorization each); 300 left 8 of the displaced cat's
-  //! faces folded, where its nodes-kept-apart run unfolded in 334
+  //! Newton steps in all at most (one factorization each)
   int max_newton = 600;
   //! Evaluate the faces' barrier terms (gradients, projected Hessians, energies) on two
   //! threads, half of the faces each, when the machine has two cores. The result is the same

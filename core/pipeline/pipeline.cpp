@@ -88,7 +88,7 @@ const CrossField& Pipeline::compute_field() {
   if (!field_solver_) {
     // Split clusters are judged against the layout's own field, whose global rotation is
     // free: it gets the rotation the parameterization would choose for it, as for a field
-    // without constraints (docs/benchmarks.md, session 15). Its u/v labels follow the
+    // without constraints. Its u/v labels follow the
     // unrotated field: compute_parameterization keeps the solver only when the final field
     // gives the same constraint rows (ParamSolver::adopt_field), else builds one.
     prepared_param_.reset();

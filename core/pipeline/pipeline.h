@@ -25,9 +25,8 @@ struct PipelineOptions {
   //! With ParamOptions::second_thread, work that runs beside the main thread's only on meshes
   //! of at least this many faces: a continued pipeline's parameterization set-up while the field
   //! is solved (Pipeline(mesh, layout, previous)) and the node optimizer's Voronoi cells while
-  //! the gradients are computed. Smaller meshes do it in sequence: a thread per re-layout costs
-  //! more than it overlaps there (the 1728-face ellipsoid's node optimization took 13 % more CPU
-  //! time with it).
+  //! the gradients are computed. Smaller meshes do it in sequence: there a thread per re-layout
+  //! costs more than it overlaps.
   int second_thread_min_faces = 10000;
   //! With ParamOptions::second_thread on meshes of at least second_thread_min_faces faces, and
   //! unless ParamOptions::vertex_order is given: the Pipeline orders the mesh's vertices by
@@ -35,10 +34,8 @@ struct PipelineOptions {
   //! beside the field, and its parameterization solvers (and those of the pipelines continued
   //! from it) take their fill-reducing ordering from that order (ParamOptions::vertex_order).
   //! The order depends on the connectivity only. A solver built before it is ready waits for it,
-  //! so the results never depend on timing. Bunny, 70K faces: the order costs 0.12 s on the
-  //! second thread, and a parameterization stage takes about 0.14 s wall instead of 0.19–0.21 s
-  //! (a symbolic analysis without AMD, and 38 % fewer flops per factorization); QuadWild's
-  //! joint (43K faces): 0.084 s instead of 0.092 s (docs/benchmarks.md, session 23).
+  //! so the results never depend on timing. The stage's symbolic analysis then needs no AMD
+  //! ordering (its effect on the stage time: docs/benchmarks.md, "Design measurements").
   bool order_vertices = true;
 };
 
@@ -86,7 +83,7 @@ class Pipeline {
   const ValidationResult& validation() const { return validation_; }
 
   //! Moves the mesh vertices to \p mesh's positions (same connectivity, same layout): updates
-  //! the geometry in place (κ continued, algorithm.md §6.1) and drops the curvature and the
+  //! the geometry in place (docs/design.md, "Continuing κ") and drops the curvature and the
   //! extraction. The field and parameterization solvers are kept (their combinatorial setup
   //! and factorization patterns do not depend on positions); call compute_parameterization()
   //! to re-solve. \throw InvalidInputError when the vertex or face count differs.

@@ -1,5 +1,5 @@
-// Immutable state of the pipeline worker at one step, published to the UI (architecture.md,
-// "Threading model"). A Snapshot is built by the worker outside any lock, then shared as
+// Immutable state of the pipeline worker at one step, published to the UI (docs/design.md,
+// "Editor and worker"). A Snapshot is built by the worker outside any lock, then shared as
 // shared_ptr<const Snapshot>; nobody modifies it after publication.
 #pragma once
 

@@ -1,5 +1,5 @@
 // The pipeline worker: one thread that owns all algorithm state, driven by a command queue,
-// streaming immutable versioned snapshots (architecture.md, "Threading model"). No GL here.
+// streaming immutable versioned snapshots (docs/design.md, "Editor and worker"). No GL here.
 //
 // The UI thread only calls the public member functions below; they lock, enqueue and notify.
 // The worker thread drains the queue between steps (never during one), runs the pluggable
