@@ -201,7 +201,7 @@ def svg_plot(title, series, path):
 NOTES_MARKER = ("<!-- Generated above (scripts/bench.sh); the notes below are written by hand "
                 "and kept when the page is regenerated. -->")
 # Before the marker existed, the hand-written notes began with this section.
-FIRST_NOTES_HEADING = "## Cross-field stage cost (session 2)"
+FIRST_NOTES_HEADING = "## Cross-field stage cost"
 
 
 def previous_notes(path):

@@ -95,7 +95,7 @@ TEST(Boundary, MaskWithArcsIntoBothEyes) {
   for (size_t i = 0; i < layout.arcs.size(); ++i)
     EXPECT_GE(layout.arcs[i].path.size(), 2u) << "could not route arc " << i;
   // Free eye holes: the field turns around each as around a regular point (the iso-lines run on
-  // across the hole), so nothing folds. Until session 23 it turned like the eyes' tangents and
+  // across the hole), so nothing folds. Before the free-hole rule it turned like the eyes' tangents and
   // the iso-lines wrapped around them: E 31454 and 45 fold-overs (unaligned), 97 (aligned).
   expect_embedding(mesh, layout, 2, /*aligned=*/false, 0.0);
   expect_embedding(mesh, layout, 2, /*aligned=*/true);
@@ -349,7 +349,7 @@ TEST(Boundary, SplitClustersFollowTheParameterizationsRotationOnTheConjugateLayo
   // field without constraints (Pipeline, CrossFieldSolver::ReferenceRotation): the clusters
   // that fit the arcs stay, E° falls below --no-align's and E stays close to it. Pinned along
   // one arc edge instead (a diagonal of the quads here, 45° off), the kept clusters twisted the
-  // field against the arcs (session 14: E 2.7×, E° 21.3° against 16.5°).
+  // field against the arcs (E 2.7×, E° 21.3° against 16.5°).
   const std::string dir = test::shared_meshes_dir();
   if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes is absent (real-mesh test)";
   const QuadImportResult in = inspired_coarsened(dir);

@@ -566,7 +566,7 @@ TEST(Cli, OrientationRemovesFoldoversWithoutNodeOptimization) {
 // arcs to its free eye holes and the field wrapping around them, --wrap-free-holes, as in
 // orientation_test), the report lists the faces they violate most and a warning names the
 // layout node next to them. Only with the field frame's sectors (--orientation-sectors field):
-// the default goes on to the solution frame's, which unfold this case (session 26).
+// the default goes on to the solution frame's, which unfold this case.
 TEST(Cli, InfeasibleOrientationNamesTheNodesWhereTheLayoutFolds) {
   const std::string dir = test::shared_meshes_dir();
   if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes not found; real meshes skipped";

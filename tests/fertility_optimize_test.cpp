@@ -84,8 +84,7 @@ TEST(FertilityOptimize, SimplifiedCageLayoutEmbedsAfterNodeOptimization) {
 // optimized layout as a user gets it (layout.json, nodes as surface points), read back on the
 // original mesh — its nodes snap to the nearest vertices and the relocated vertices are back in
 // place — and parameterized with fixed nodes and orientation constraints. The cage's own node
-// positions cannot do this (the constrained QP is infeasible there, docs/benchmarks.md
-// "Session 12"); the optimized positions can.
+// positions cannot do this (the constrained QP is infeasible there); the optimized positions can.
 TEST(FertilityOptimize, OptimizedLayoutEmbedsWithFixedNodesAndOrientationConstraints) {
   QS_OPTIMIZED_OR_SKIP(o);
   ASSERT_TRUE(o->result.pipeline);

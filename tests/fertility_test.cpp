@@ -134,8 +134,7 @@ TEST(Fertility, FieldIndicesAreTheLayoutsAndSumToEuler) {
 
 // Issue #4: the embedding traced on the parameterization (--no-node-opt). Disabled: with the
 // cage's own node positions the parameterization folds (664–2304 fold-overs, 237 nodes with a
-// wrong cone angle in the tree of session 4; see docs/benchmarks.md "Fertility layout (session
-// 3)"), so the traced layout is not structurally equivalent; the simplified cage layout (above)
+// wrong cone angle), so the traced layout is not structurally equivalent; the simplified cage layout (above)
 // folds less (504 aligned, 750 --no-align) but is not equivalent either. After node optimization
 // the simplified layout embeds (fertility_optimize_test.cpp: 0 fold-overs, structurally
 // equivalent); the plain one keeps about 600 fold-overs (65 wrongly winding nodes). The layout
@@ -163,9 +162,8 @@ TEST(Fertility, DISABLED_ParameterizationEmbedsTheLayout) {
 // Issue #4: E° of the aligned parameterization is lower than that of the --no-align baseline
 // with the same layout — with split curvature clusters (CrossFieldOptions::max_cluster_faces,
 // `--max-cluster-faces 10`). With whole clusters (the default) it is false on this layout
-// (session 3: aligned 19.8°, --no-align 18.1°; 10 of the 12 constraint clusters are dropped
-// as contradicting the layout), see docs/benchmarks.md "Fertility layout (session 3)" and
-// "Session 14"; the default's numbers are printed.
+// (10 of the 12 constraint clusters are dropped as contradicting the layout); the default's
+// numbers are printed.
 TEST(Fertility, SplitClustersAlignmentLowersAngleError) {
   QS_FERTILITY_OR_SKIP(f);
   double angle[3] = {0, 0, 0};

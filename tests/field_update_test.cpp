@@ -1,4 +1,4 @@
-// CrossFieldSolver::update_layout when the constraint set changed (session 5): a node
+// CrossFieldSolver::update_layout when the constraint set changed: a node
 // optimization trial moves nodes to other vertices and relocates them, the curvature's
 // reliable set changes, and the continued solver sets up again with the constructor's steps.
 // Its drop passes tolerate as many mismatching edges (principal matching of the field ≠ period

@@ -1,4 +1,4 @@
-// Synthetic meshes and layouts for tests (algorithm.md §10), plus paths to test data.
+// Synthetic meshes and layouts for tests (docs/design.md, "Test inputs"), plus paths to test data.
 #pragma once
 
 #include <array>
@@ -87,7 +87,7 @@ MeshAndLayout flat_square_with_free_hole();
 //! edges everywhere along the arcs; flat patches. The voxel set must give a manifold surface.
 MeshAndLayout voxel_surface(const std::vector<std::array<int, 3>>& voxels, int k);
 
-//! The genus-2 polycube of algorithm.md §10: a 5×3×1 voxel block minus two separated
+//! The genus-2 polycube of docs/design.md, "Test inputs": a 5×3×1 voxel block minus two separated
 //! columns (nodes of valence 3, 4 and 5).
 MeshAndLayout genus2_polycube(int k);
 

@@ -1,5 +1,5 @@
 // The geometry cache under vertex moves: κ continued across updates keeps the parallel
-// transport around every vertex (algorithm.md §6.1, "Continue κ across geometry updates").
+// transport around every vertex (docs/design.md, "Continuing κ").
 #include "core/mesh/geometry.h"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The node optimizer's fewest-fold-over fallback (session 5; NodeOptResult::
+// The node optimizer's fewest-fold-over fallback (NodeOptResult::
 // fewest_foldovers_reverted): when the fold-over removal leaves fold-overs at the end of the
 // descent, the accepted state with the fewest fold-overs is finished the same way and returned
 // when it ends with fewer fold-overs (as many: lower final E).

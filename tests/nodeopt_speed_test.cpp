@@ -1,4 +1,4 @@
-// Work reuse of the node optimization (issue #5, session 3): the Pipeline continued after node
+// Work reuse of the node optimization (issue #5): the Pipeline continued after node
 // moves (Pipeline(mesh, layout, previous): field solver copy + update_layout), the copy-on-write
 // SpdSolver with its ordering hint, and the cached routing obstacles of re-routing.
 #include <gtest/gtest.h>

@@ -43,7 +43,7 @@ struct FrozenCase {
 };
 
 // Compares the estimator with central differences of the parameterization energy re-solved
-// with the field frozen (algorithm.md §6.1 convention). Returns the worst relative error over
+// with the field frozen (docs/design.md, "Gradient"). Returns the worst relative error over
 // nodes with a non-negligible gradient.
 double frozen_gradient_check(const FrozenCase& c, int* checked) {
   ParamOptions opt;
@@ -415,7 +415,7 @@ RecoveryOutcome run_recovery(const char* name, const test::MeshAndLayout& in, do
 // Sweeps over the neighbours of every node (hop_min_offset 0, 8 candidates in any direction,
 // 64 evaluations per sweep, 10 sweeps) give 1.03–1.15 E* there and sometimes returns to E* exactly,
 // but on the icosphere cases below (16 evaluations) it was worse as often as better (prism seed
-// 2: 1.01 -> 1.43 E*). Since session 5 the default sweep tries every relocated node
+// 2: 1.01 -> 1.43 E*). The default sweep tries every relocated node
 // (hop_min_offset 0, 2 candidates in the relocation direction, 64 evaluations, stopping after
 // 16 failures in a row) after a collective undo and the cone passes: the icosphere cases end
 // at or below their earlier values (prism seed 2: 1.0012 E*). On the icosphere with 5120 faces,

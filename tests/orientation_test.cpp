@@ -1,4 +1,4 @@
-// Fold-over removal by strict orientation constraints (issue #5 item 6, algorithm.md §7.2):
+// Fold-over removal by strict orientation constraints (issue #5 item 6, docs/design.md, "Orientation constraints"):
 // the tri-sector QP solver on small hand-made problems, the constrained parameterization on a
 // folding synthetic layout (equality constraints still exact), the node optimizer's final solve
 // on the bundled example and on real layouts.
@@ -600,7 +600,7 @@ void expect_named_faces_at_eye_holes(const TriMesh& mesh, const OrientationRepor
 
 // mask_confmap.obj (three boundary loops) with one node and four dangling arcs to the eye
 // holes and the outer boundary (as in boundary_test), with the field wrapping around the free
-// eye holes (FreeLoopTurning::kWrap, the default until session 23; the default now embeds this
+// eye holes (FreeLoopTurning::kWrap, the earlier default; the default now embeds this
 // layout): the fold-overs where the iso-lines wrap around the holes cannot be removed by the
 // tri-sector constraints (the QP is infeasible). The solve must say so and keep the
 // unconstrained solution; the node optimizer then falls back to stiffening.

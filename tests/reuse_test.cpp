@@ -431,8 +431,8 @@ TEST(ReuseParam, PipelineOrdersTheVerticesOnceForItsSolvers) {
 // The vertex order on a layout whose cut merges wedges along long seams: the pig's quad mesh
 // refined 3 times (as `import-quads --refine 3`, 41400 faces, 942 nodes), where most merged
 // unknowns have about 70 entries per column. The parameterization's ordering from the vertex
-// order must keep about AMD's fill on its own (no rescue by the solver's fill check): until
-// session 24 it sent those unknowns last, unordered, with 13 times AMD's fill and a 3.3 s
+// order must keep about AMD's fill on its own (no rescue by the solver's fill check): an
+// earlier ordering sent those unknowns last, unordered, with 13 times AMD's fill and a 3.3 s
 // factorization instead of 0.06 s.
 TEST(ReuseParam, VertexOrderKeepsTheFillOfAmdWhereSeamsMergeManyWedges) {
   const std::string dir = test::shared_meshes_dir();

@@ -36,7 +36,7 @@ struct BigInput {
   int faces = 0;
 };
 
-// cube_sphere(k) has 12 k² triangles: k = 60 gives 43 200 (`--no-node-opt`: 0.3 s in session 8).
+// cube_sphere(k) has 12 k² triangles: k = 60 gives 43 200 (`--no-node-opt`: about 0.3 s).
 const BigInput& big_input() {
   static const BigInput input = [] {
     BigInput in;
@@ -134,7 +134,7 @@ struct RunOutcome {
 };
 
 // \p node_opt: the whole pipeline (5 node optimization steps, seconds) instead of
-// --no-node-opt (0.3 s on an idle machine in session 8).
+// --no-node-opt (about 0.3 s on an idle machine).
 RunOutcome run_and_signal(const std::string& out, int signo, std::chrono::milliseconds delay,
                           bool node_opt = false) {
   const BigInput& in = big_input();

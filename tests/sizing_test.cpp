@@ -1,4 +1,4 @@
-// Curl-reducing sizing field (core/param/sizing.h, algorithm.md §4.4) and its use in the
+// Curl-reducing sizing field (core/param/sizing.h, docs/design.md, "Sizing field") and its use in the
 // parameterization, the node-gradient estimator and the command line.
 #include "core/param/sizing.h"
 

@@ -283,8 +283,8 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       // orientation-constrained solve embeds the layout), the input is optimized again with
       // NodeOptOptions::keep_nodes_apart, and that run is taken when it ends with fewer fold-overs,
       // or as many at a lower E. Nodes crowding onto one triangle are what made the exact pig's
-      // optimized layouts fail (docs/benchmarks.md session 27: the default falls back to the
-      // initial state, E 2.048; kept apart, E 1.578 and no fold-overs). Not the default itself:
+      // optimized layouts fail (the default fell back to the initial state;
+      // kept apart, the optimized layout embedded). Not the default itself:
       // crowded starts (the displaced spot) then keep fold-overs the default removes.
       // The rules: core/nodeopt/retry.h.
       if (may_retry_apart && wants_keep_apart_retry(*node_result)) {
@@ -303,8 +303,8 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       // the initial state (the node movement given up), the layout is optimized again from the
       // input with the sizing field (and the keep-apart choice made above), and that run is
       // taken when it ends with fewer fold-overs, or as many without falling back to the initial
-      // state (the rocker-arm cage layout with the field frame's sectors: 81 without, 0 with;
-      // docs/benchmarks.md sessions 24-25; the exact cow: 121 without, 0 with). E is no
+      // state (the rocker-arm cage layout with the field frame's sectors and the exact cow
+      // embed only with it). E is no
       // criterion here: the sizing field changes the energy. An explicit --sizing or
       // --no-sizing decides up front; --no-orientation (stiffening only, an ablation) and the
       // discrete baseline are run as asked.

@@ -1190,7 +1190,7 @@ struct NodeOptimizer::Impl {
       out.E_final = ev.E;
       out.foldovers_final = ev.foldovers;
 
-      // Fold-over removal: strict orientation constraints in the last solve (algorithm.md §7.2),
+      // Fold-over removal: strict orientation constraints in the last solve (docs/design.md, "Orientation constraints"),
       // stiffening (§7.1) only as the fallback when fold-overs remain.
       const bool at_this_state =
           no.orientation_at_moved_states || (initial_state && same_state(*initial_state, st_in));

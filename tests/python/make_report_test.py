@@ -16,7 +16,7 @@ import make_report  # noqa: E402
 
 MACHINE = {"nproc": "2", "cpu": "test cpu", "memory": "1Gi", "load": "0.0", "date": "today",
            "commit": "abc1234", "command": "scripts/bench.sh", "runtime_s": 1}
-NOTES = "## Session 99: a note\n\nNumbers nobody can regenerate: 1.234 s.\n"
+NOTES = "## A note\n\nNumbers nobody can regenerate: 1.234 s.\n"
 
 
 def write_run(runs, name, report):
