@@ -68,7 +68,7 @@ nlohmann::json read_json(const std::string& path) {
 TEST(WorkingMeshCli, PointLayoutValidatesAndOptimizesOnAWorkingMesh) {
   const std::string dir = test::temp_dir("working_mesh_cli");
   const std::string layout = point_layout(dir);
-  const std::string mesh = test::assets_dir() + "/example/ellipsoid.obj";
+  const std::string mesh = test::mesh_file(test::assets_dir() + "/example/ellipsoid.obj");
   std::string log;
   ASSERT_EQ(test::run_command(test::cli_path() + " validate --mesh " + mesh + " --layout " +
                                   layout + " --out " + dir + "/validate",
