@@ -234,15 +234,27 @@ class CrossFieldSolver {
   //! (rotation_anchor_: update_layout keeps the rotation as nodes move), else 0.
   double choose_reference_rotation(const Eigen::VectorXd& reference,
                                    const ReferenceRotation& reference_rotation);
-  void round_clusters(const std::vector<double>& c, const Eigen::VectorXd& theta);
+  //! Each cluster's offset that best matches \p theta (per face) at its constraints in force;
+  //! with \p only (per cluster) only the clusters it flags.
+  void round_clusters(const std::vector<double>& c, const Eigen::VectorXd& theta,
+                      const std::vector<char>* only = nullptr);
   //! arc_gauge_face_ and arc_gauge_angle_ for \p layout (-1 / 0 without arcs).
   void choose_arc_gauge(const TriMesh& mesh, const GeometryCache& geometry, const Layout& layout);
   //! Drop passes while more than \p tolerated edges mismatch (update_layout tolerates the
-  //! ones the passes could not remove before).
+  //! ones the passes could not remove before). With \p curvature_only only curvature
+  //! constraints are released (after the structural pass settled the others).
   void drop_conflicting_clusters(const TriMesh& mesh, const GeometryCache& geometry,
-                                 int tolerated = 0);
-  //! Split mode (max_cluster_faces > 0): the conflict passes for the feature and boundary
-  //! clusters alone, as a run without curvature constraints does them, before the curvature
+                                 int tolerated = 0, bool curvature_only = false);
+  //! The common end of setup and update_layout: the structural pass (when it applies, with the
+  //! warm start of the feature and boundary clusters inside it; the curvature clusters then
+  //! start from the layout's own field), else the warm start; the deviation release, the solve
+  //! and the conflict passes (curvature clusters only after a structural pass).
+  void settle_and_warm_start(const TriMesh& mesh, const GeometryCache& geometry, int tolerated,
+                             bool allow_factorization,
+                             const ReferenceRotation& reference_rotation = {});
+  //! Split mode (max_cluster_faces > 0): the warm start and the conflict passes for the
+  //! feature and boundary clusters alone, as a run without curvature constraints does them
+  //! (warm_start with \p allow_factorization and \p reference_rotation), before the curvature
   //! clusters come back into force (one factorization per pass; the next solve factorizes the
   //! matrix with the curvature constraints back, with no pass the full one). Otherwise
   //! the curvature clusters next to a feature or boundary cluster that contradicts the layout were
@@ -251,7 +263,10 @@ class CrossFieldSolver {
   //! dropped (structural_dropped_): they are dropped again at once, and passes run only while
   //! more edges mismatch than \p tolerated (on the 70K bunny 1730 of 1750 feature faces are
   //! dropped every descent step: one pass-free factorization instead of four to six).
-  void drop_structural_conflicts(const TriMesh& mesh, const GeometryCache& geometry, int tolerated);
+  //! Returns whether the pass ran (structural_pass_applies).
+  bool drop_structural_conflicts(const TriMesh& mesh, const GeometryCache& geometry, int tolerated,
+                                 bool allow_factorization,
+                                 const ReferenceRotation& reference_rotation = {});
   //! Whether drop_structural_conflicts runs its passes with every constraint in force.
   bool structural_pass_applies() const;
   //! Releases the curvature clusters that deviate from the layout's own field
