@@ -9,6 +9,7 @@
 
 #include "core/base/errors.h"
 #include "core/base/timing.h"
+#include "core/field/matching_repair.h"
 
 namespace qs {
 
@@ -135,6 +136,7 @@ void CrossFieldSolver::setup(const TriMesh& mesh, const GeometryCache& g, const 
   settle_and_warm_start(mesh, g, tolerated, /*allow_factorization=*/true, reference_rotation);
   residual_mismatches_ = count_mismatches(g);
   field_.active_constraints = nc - field_.dropped_constraints;
+  repair_matching(g);
 }
 
 CrossFieldSolver::~CrossFieldSolver() = default;
@@ -160,7 +162,7 @@ void CrossFieldSolver::settle_and_warm_start(const TriMesh& mesh, const Geometry
     warm_start(g, allow_factorization, reference_rotation);
   }
   release_deviating_clusters(g);
-  solve(g);
+  solve_system(g);
   // After the structural pass only curvature clusters are released: the feature and boundary
   // constraints it kept agree with the layout.
   drop_conflicting_clusters(mesh, g, tolerated, /*curvature_only=*/structural);
@@ -640,7 +642,7 @@ void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const Geom
     // The trial's solve re-rounds the cluster offsets: kept for the restore below.
     const std::vector<int> offsets_before = cluster_offset_;
     factorize_as_current();
-    solve(g);
+    solve_system(g);
     ++field_.timings.conflict_passes;
     const int now = count_mismatches(g);
     if (now >= mismatches) {
@@ -669,14 +671,14 @@ void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const Geom
       // 9.51 and 956; on a bunny cage layout the re-rounded one has 2 mismatches instead of 1.
       const std::vector<int> offsets_trial = cluster_offset_;
       cluster_offset_ = offsets_before;
-      solve(g);
+      solve_system(g);
       if (offsets_trial != offsets_before) {
         const int kept_mismatches = count_mismatches(g);
         const double kept_energy = energy(g);
         const CrossField kept = field_;
         const std::vector<int> kept_offsets = cluster_offset_;
         cluster_offset_ = offsets_trial;
-        solve(g);
+        solve_system(g);
         const int m = count_mismatches(g);
         if (m > kept_mismatches || (m == kept_mismatches && energy(g) >= kept_energy)) {
           field_ = kept;
@@ -768,7 +770,7 @@ bool CrossFieldSolver::drop_structural_conflicts(const TriMesh& mesh, const Geom
   // zero (which twisted the clusters of a boundary-aligned layout against each other, and the
   // pass released them all).
   warm_start(g, allow_factorization, reference_rotation);
-  solve(g);
+  solve_system(g);
   drop_conflicting_clusters(mesh, g, tolerated);
   if (current_) {  // the structural matrix after its drops, for the next pass
     structural_ = solver_;
@@ -941,6 +943,21 @@ void CrossFieldSolver::round_clusters(const std::vector<double>& c, const Eigen:
 }
 
 const CrossField& CrossFieldSolver::solve(const GeometryCache& g) {
+  solve_system(g);
+  repair_matching(g);
+  return field_;
+}
+
+void CrossFieldSolver::repair_matching(const GeometryCache& g) {
+  // The faces the constraints in force (and the gauge) hold keep their θ.
+  std::vector<char> fixed(g.n_faces, 0);
+  for (size_t k = 0; k < field_.constraints.face.size(); ++k)
+    if (active(static_cast<int>(k))) fixed[field_.constraints.face[k]] = 1;
+  if (field_.gauge_face >= 0) fixed[field_.gauge_face] = 1;
+  repair_principal_matching(g, field_.period_jump, fixed, field_.theta);
+}
+
+const CrossField& CrossFieldSolver::solve_system(const GeometryCache& g) {
   if (g.n_faces != matrix_.rows())
     throw InvalidInputError("cross field: the geometry has " + std::to_string(g.n_faces) +
                             " faces, the solver was built for " + std::to_string(matrix_.rows()));
@@ -1024,6 +1041,7 @@ const CrossField& CrossFieldSolver::update_layout(const TriMesh& mesh, const Geo
   settle_and_warm_start(mesh, g, residual_mismatches_, /*allow_factorization=*/false);
   field_.active_constraints =
       static_cast<int>(field_.constraints.face.size()) - field_.dropped_constraints;
+  repair_matching(g);
   return field_;
 }
 

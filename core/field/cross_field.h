@@ -120,6 +120,9 @@ struct CrossField {
 };
 
 //! Stateful solver: builds constraints, period jumps and the factorized matrix once. The
+//! returned field is the smoothest one, except around edges where that one turns by more than
+//! 45° against its period jump: there it is smoothed until its principal matching is the
+//! period jumps (repair_matching), so its singularities are exactly the layout's. The
 //! matrix depends on neither the geometry nor the period jumps, only on the set of active
 //! constraints: `solve` after vertices moved and `update_layout` after nodes moved to other
 //! vertices (new period jumps) only back-substitute with the existing factorization.
@@ -154,7 +157,8 @@ class CrossFieldSolver {
   //! Solves for θ with the current geometry (reuses the factorization). \p geometry must be the
   //! construction's cache continued by update_geometry (same connectivity, κ continued), so that
   //! the period jumps stay valid. The constraint directions are the original 3D directions,
-  //! projected onto the current faces.
+  //! projected onto the current faces. As after the constructor and update_layout, the field's
+  //! principal matching is then repaired (repair_matching).
   const CrossField& solve(const GeometryCache& geometry);
   //! After the layout changed on the same mesh connectivity (nodes moved to other vertices,
   //! arcs rerouted, vertices relocated): collects the constraints of the current geometry and
@@ -275,6 +279,15 @@ class CrossFieldSolver {
   void release_deviating_clusters(const GeometryCache& geometry);
   //! Interior edges whose principal matching differs from the period jump.
   int count_mismatches(const GeometryCache& geometry) const;
+  //! The linear solve and cluster rounding of solve(), without the repair (the passes'
+  //! solves, which judge the constraints by the smoothest field's mismatches).
+  const CrossField& solve_system(const GeometryCache& geometry);
+  //! The last step of every public solve: where the smoothest field turns by more than 45°
+  //! across an edge against its period jump, θ is smoothed around that edge
+  //! (repair_principal_matching; faces of constraints in force and the gauge face held), so the
+  //! singularities measured on the field alone (field_quarter_indices) are the period jumps'
+  //! (the layout's irregular nodes).
+  void repair_matching(const GeometryCache& geometry);
   //! The energy the solve minimizes, at field_.theta: Σ over interior edges of the squared
   //! step against transport and period jump, plus λ·(θ_f − target)² on the constraints in force
   //! (current cluster offsets) and on the gauge face.
