@@ -160,6 +160,10 @@ class CrossFieldSolver {
   //! projected onto the current faces. As after the constructor and update_layout, the field's
   //! principal matching is then repaired (repair_matching).
   const CrossField& solve(const GeometryCache& geometry);
+  //! Interior edges where the smoothest field of the last constructor or set-up turned by more
+  //! than 45° against its period jump after the conflict passes (before repair_matching): the
+  //! mismatches update_layout's passes tolerate.
+  int residual_mismatches() const { return residual_mismatches_; }
   //! After the layout changed on the same mesh connectivity (nodes moved to other vertices,
   //! arcs rerouted, vertices relocated): collects the constraints of the current geometry and
   //! layout as the constructor does (curvature recomputed). When they are on the same faces
