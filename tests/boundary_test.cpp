@@ -197,6 +197,54 @@ TEST(Boundary, CornerNodesOffTheMeshCorners) {
   }
 }
 
+// Boundary and feature constraints are settled first and kept when the layout agrees with them
+// (issue #44 item 2): a 2×2 grid whose boundary arcs follow the whole boundary loop of a real
+// disk (face.obj, a relief with sharp features) keeps every boundary and feature constraint in
+// force with the curvature constraints on (split clusters, the default), as it does without
+// them; the curvature constraints are the ones released where they contradict the layout. Also
+// when the solver is updated for the layout (node optimization's path). Before, the structural
+// pass solved with the clusters' rotations unset and released all 96 boundary and 40 feature
+// faces.
+TEST(Boundary, AlignedGridKeepsEveryBoundaryAndFeatureConstraint) {
+  const std::string dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/meshes is absent (real-mesh test)";
+  const TriMesh mesh = test::load_mesh(dir + "/face.obj");
+  const auto loops = boundary_loops(mesh);
+  ASSERT_EQ(loops.size(), 1u);
+  const Layout layout = loop_grid_layout(mesh, loops[0], 0);
+  for (const auto& a : layout.arcs) ASSERT_GE(a.path.size(), 2u) << "arc " << a.id;
+  ASSERT_TRUE(validate_layout(mesh, layout).valid());
+  const int boundary = static_cast<int>(ConstraintKind::Boundary);
+  const int feature = static_cast<int>(ConstraintKind::Feature);
+  const int curvature = static_cast<int>(ConstraintKind::Curvature);
+  auto expect_structural_in_force = [&](const ConstraintSummary& s, const char* what) {
+    EXPECT_GT(s.constrained[boundary], 0) << what;
+    EXPECT_GT(s.constrained[feature], 0) << what;
+    EXPECT_EQ(s.in_force[boundary], s.constrained[boundary]) << what;
+    EXPECT_EQ(s.in_force[feature], s.constrained[feature]) << what;
+    std::printf(
+        "[stat] face.obj 2x2 boundary grid, %s: boundary %d of %d, feature %d of %d, curvature "
+        "%d of %d in force\n",
+        what, s.in_force[boundary], s.constrained[boundary], s.in_force[feature],
+        s.constrained[feature], s.in_force[curvature], s.constrained[curvature]);
+  };
+  PipelineOptions plain;
+  plain.field.constraints.curvature = false;
+  Pipeline unaligned(mesh, layout, plain);
+  expect_structural_in_force(summarize_constraints(unaligned.compute_field()), "--no-align");
+
+  Pipeline aligned(mesh, layout, PipelineOptions{});
+  const ConstraintSummary s = summarize_constraints(aligned.compute_field());
+  expect_structural_in_force(s, "aligned");
+  EXPECT_GT(s.in_force[curvature], 0);
+
+  const GeometryCache g = build_geometry(mesh);
+  const LayoutTopology topo = build_topology(mesh, layout);
+  CrossFieldSolver solver(mesh, g, layout, topo, CrossFieldOptions{});
+  expect_structural_in_force(summarize_constraints(solver.update_layout(mesh, g, layout, topo)),
+                             "aligned, updated");
+}
+
 // Node optimization of those layouts (issue #5 item 3 on an aligned boundary): the 8 boundary
 // nodes slide along the boundary onto the square's corners and side midpoints, where the
 // layout is exact (E = 0 up to round-off); without sliding they stay and E stays.

@@ -67,58 +67,27 @@ class Tracer {
     V2 point = at(face, start_vertex);
     int at_vertex = start_vertex;
     HH entry;  // halfedge of `face` we entered through (invalid at a vertex)
-    double entry_t = 0;
     const long cap = static_cast<long>(opt_.max_steps_factor) * g_.n_faces + 16;
     for (long step = 0; step < cap; ++step) {
-      // Candidates in the current face: vertex hits and edge crossings ahead along dir.
-      const auto& fv = g_.face_vertices[face];
-      // fh[k]: the face's halfedge fv[k] → fv[k + 1] (the face's own loop: no vertex
-      // circulation as in find_halfedge).
-      HH fh[3];
-      {
-        HH h = mesh_.halfedge_handle(mesh_.face_handle(face));
-        for (int i = 0; i < 3; ++i, h = mesh_.next_halfedge_handle(h)) {
-          const int from = mesh_.from_vertex_handle(h).idx();
-          fh[from == fv[0] ? 0 : (from == fv[1] ? 1 : 2)] = h;
-        }
-      }
-      const int axis = std::abs(dir[0]) > 0.5 ? 1 : 0;  // constant coordinate
-      const double c = point[axis];
-      double diam = 0;
-      for (int k = 0; k < 3; ++k)
-        diam = std::max(diam, norm(sub(uv_[3 * face + k], uv_[3 * face + (k + 1) % 3])));
-      const double eps = opt_.vertex_snap * std::max(diam, 1e-300);
-      double lam[3];
-      bool snapped[3];
-      for (int k = 0; k < 3; ++k) {
-        lam[k] = uv_[3 * face + k][axis] - c;
-        snapped[k] = std::abs(lam[k]) <= eps;
-      }
-      double best = eps;
-      int best_vertex = -1, best_edge = -1;
-      double best_t = 0;
-      for (int k = 0; k < 3; ++k) {
-        if (fv[k] == at_vertex || !snapped[k]) continue;
-        const double prog = dot(sub(uv_[3 * face + k], point), dir);
-        if (prog > best) best = prog, best_vertex = k, best_edge = -1;
-      }
-      for (int k = 0; k < 3; ++k) {
-        const int l = (k + 1) % 3;
-        if (snapped[k] || snapped[l]) continue;
-        if ((lam[k] > 0) == (lam[l] > 0)) continue;
-        if (fh[k] == entry) continue;
-        const double t = lam[k] / (lam[k] - lam[l]);
-        const double prog = dot(sub(lerp(uv_[3 * face + k], uv_[3 * face + l], t), point), dir);
-        if (prog > best) best = prog, best_edge = k, best_t = t, best_vertex = -1;
-      }
-      if (best_vertex < 0 && best_edge < 0)
+      const Event ev = next_event(face, point, dir, at_vertex, entry);
+      if (ev.vertex < 0 && ev.edge < 0)
         return fail(out, "stuck in face " + std::to_string(face) +
                              (folded(face) ? " (folded in the parameterization)"
                                            : " (fold-over or degenerate chart)"));
+      const auto& fv = g_.face_vertices[face];
+      const int axis = constant_axis(dir);
+      const double best = ev.progress;
+      const int best_vertex = ev.vertex, best_edge = ev.edge;
+      const double best_t = ev.t;
       out.param_length += best;
       if (best_vertex >= 0) {
         const int w = fv[best_vertex];
-        point = uv_[3 * face + best_vertex];
+        // The line passes within eps of w. It goes on at its own constant coordinate, offset
+        // from w by `beside` (perpendicular to dir, carried into the next face's chart with
+        // dir): taking w's coordinate instead let the line drift by up to eps at every vertex
+        // it grazed, and a line along mesh edges then passed beside its end node.
+        V2 beside{0, 0};
+        beside[axis] = point[axis] - uv_[3 * face + best_vertex][axis];
         add_vertex_sample(out, face, w);
         if (node_at_[w] >= 0) {
           if (node_at_[w] == end_node) {
@@ -134,14 +103,15 @@ class Tracer {
         }
         at_vertex = w;
         entry = HH();
-        if (!find_sector(w, face, dir))
+        if (!find_sector(w, face, dir, beside))
           return fail(out, "no continuation at vertex " + std::to_string(w) + fold_note(w));
         point = at(face, w);
+        point = {point[0] + beside[0], point[1] + beside[1]};
         continue;
       }
       // Edge crossing.
       const int k = best_edge, l = (k + 1) % 3;
-      const HH h = fh[k];
+      const HH h = face_halfedge(face, k);
       add_edge_sample(out, face, k, best_t);
       const HH opp = mesh_.opposite_halfedge_handle(h);
       if (mesh_.is_boundary(opp)) {
@@ -158,15 +128,114 @@ class Tracer {
       point = lerp(at(next, fv[k]), at(next, fv[l]), best_t);
       face = next;
       entry = opp;
-      entry_t = best_t;
       at_vertex = -1;
     }
-    (void)entry_t;
     (void)start_node;
     return fail(out, "step limit reached");
   }
 
+  // What the line meets next in a face, ahead along its direction.
+  struct Event {
+    int vertex = -1;      //!< corner (0..2) of a vertex the line passes within the snap distance
+    int edge = -1;        //!< else the edge fv[edge] → fv[edge + 1] it crosses
+    double t = 0;         //!< the crossing's parameter along that edge
+    double progress = 0;  //!< parametric distance from the line's point, along its direction
+  };
+
+  static int constant_axis(const V2& dir) { return std::abs(dir[0]) > 0.5 ? 1 : 0; }
+
+  // The face's halfedge fv[k] → fv[k + 1] (the face's own loop: no vertex circulation as in
+  // find_halfedge).
+  HH face_halfedge(int f, int k) const {
+    const int from = g_.face_vertices[f][k];
+    HH h = mesh_.halfedge_handle(mesh_.face_handle(f));
+    while (mesh_.from_vertex_handle(h).idx() != from) h = mesh_.next_halfedge_handle(h);
+    return h;
+  }
+
+  // The first vertex hit or edge crossing ahead of `point` along `dir` (an axis direction) in
+  // face f's chart, other than vertex `at_vertex` and the halfedge `entry` the line came in
+  // through; none (vertex and edge −1) when the line does not go on through f. A vertex within
+  // the snap distance of the line (TraceOptions::vertex_snap, relative to the face's parametric
+  // size) is hit, and the line crosses no edge at it.
+  Event next_event(int f, const V2& point, const V2& dir, int at_vertex, HH entry) const {
+    const auto& fv = g_.face_vertices[f];
+    const int axis = constant_axis(dir);
+    const double c = point[axis];
+    double diam = 0;
+    for (int k = 0; k < 3; ++k)
+      diam = std::max(diam, norm(sub(uv_[3 * f + k], uv_[3 * f + (k + 1) % 3])));
+    const double eps = opt_.vertex_snap * std::max(diam, 1e-300);
+    double lam[3];
+    bool snapped[3];
+    for (int k = 0; k < 3; ++k) {
+      lam[k] = uv_[3 * f + k][axis] - c;
+      snapped[k] = std::abs(lam[k]) <= eps;
+    }
+    // Any progress counts, not only more than the snap distance: a line through a corner of
+    // the face beside a vertex it does not graze advances by less than that there.
+    Event ev;
+    for (int k = 0; k < 3; ++k) {
+      if (fv[k] == at_vertex || !snapped[k]) continue;
+      const double prog = dot(sub(uv_[3 * f + k], point), dir);
+      if (prog > ev.progress) ev = {k, -1, 0, prog};
+    }
+    for (int k = 0; k < 3; ++k) {
+      const int l = (k + 1) % 3;
+      if (snapped[k] || snapped[l]) continue;
+      if ((lam[k] > 0) == (lam[l] > 0)) continue;
+      if (entry.is_valid() && face_halfedge(f, k) == entry) continue;
+      const double t = lam[k] / (lam[k] - lam[l]);
+      const double prog = dot(sub(lerp(uv_[3 * f + k], uv_[3 * f + l], t), point), dir);
+      if (prog > ev.progress) ev = {-1, k, t, prog};
+    }
+    return ev;
+  }
+
+  // Whether the line leaving vertex w at offset `beside` (perpendicular to dir; zero at a node)
+  // in direction dir goes on through face f (f's chart).
+  bool goes_through(int f, int w, const V2& dir, const V2& beside) const {
+    const V2 W = at(f, w);
+    const Event ev = next_event(f, {W[0] + beside[0], W[1] + beside[1]}, dir, w, HH());
+    return ev.vertex >= 0 || ev.edge >= 0;
+  }
+
+  // A line along an edge of f's corner wedge at w lies in the wedges on both sides of that
+  // edge up to the tolerance; only on one of them does it go on (the side it passes w on, or
+  // the side of the edge's far vertex it passes). When it does not go on through f (chart
+  // `dir`, `beside`), this takes the neighbouring face across that edge if it holds the
+  // direction and the line goes on there (and carries dir and beside into its chart).
+  void settle_on_edge(int w, int& f, V2& dir, V2& beside) const {
+    if (goes_through(f, w, dir, beside)) return;
+    const int k = corner_of(g_, f, w);
+    const V2 W = uv_[3 * f + k];
+    const V2 a = sub(uv_[3 * f + (k + 1) % 3], W), b = sub(uv_[3 * f + (k + 2) % 3], W);
+    const double tol = 1e-9;
+    HH cur = outgoing_in_face(w, f);
+    V2 d = dir;
+    if (std::abs(cross(a, dir)) <= tol * norm(a) && dot(a, dir) > 0)
+      cur = step_cw(cur, w, d);  // across the first edge
+    else if (std::abs(cross(b, dir)) <= tol * norm(b) && dot(b, dir) > 0)
+      cur = step_ccw(cur, w, d);  // across the second edge
+    else
+      return;
+    if (!cur.is_valid()) return;
+    const int f2 = mesh_.face_handle(cur).idx();
+    const V2 b2 = rotate(quarter_turns(dir, d), beside);
+    if (!in_wedge(f2, w, d) || !goes_through(f2, w, d, b2)) return;
+    f = f2;
+    dir = d;
+    beside = b2;
+  }
+
   V2 at(int f, int v) const { return uv_[3 * f + corner_of(g_, f, v)]; }
+
+  // The quarter turns r with rotate(r, from) == to (axis directions).
+  static int quarter_turns(const V2& from, const V2& to) {
+    for (int r = 1; r < 4; ++r)
+      if (rotate(r, from) == to) return r;
+    return 0;
+  }
 
   bool folded(int f) const {
     const V2 a = sub(uv_[3 * f + 1], uv_[3 * f]), b = sub(uv_[3 * f + 2], uv_[3 * f]);
@@ -228,9 +297,15 @@ class Tracer {
   // ways took the occurrence fewer wedges away: on the 70K bunny after node optimization
   // three arcs of a valence-5 node started one sector off and ran into their neighbours'
   // nodes, although the parameterization had no fold-over.)
+  // An arc along a mesh edge starts on the side of it where its line goes on
+  // (settle_on_edge).
   std::vector<Start> start_sectors(int w, int face, const V2& dir) const {
-    const auto [ccw, ccw_angle] = first_occurrence(w, face, dir, true);
-    const auto [cw, cw_angle] = first_occurrence(w, face, dir, false);
+    auto [ccw, ccw_angle] = first_occurrence(w, face, dir, true);
+    auto [cw, cw_angle] = first_occurrence(w, face, dir, false);
+    for (Start* s : {&ccw, &cw}) {
+      V2 beside{0, 0};
+      if (s->face >= 0) settle_on_edge(w, s->face, s->dir, beside);
+    }
     std::vector<Start> out;
     if (ccw.face >= 0) out.push_back(ccw);
     // (Both ways can end in one face with two different directions: keep both.)
@@ -293,8 +368,17 @@ class Tracer {
   }
 
   // Finds the face around w (starting at `face`, sweeping both ways with transitions) whose
-  // corner wedge contains dir; updates face and dir to that face's chart.
-  bool find_sector(int w, int& face, V2& dir) const {
+  // corner wedge contains dir, on the side of the edge the line passes when dir runs along
+  // one (settle_on_edge); updates face, dir and the line's offset `beside` from w to that
+  // face's chart.
+  bool find_sector(int w, int& face, V2& dir, V2& beside) const {
+    const V2 dir0 = dir;
+    if (!find_wedge(w, face, dir)) return false;
+    beside = rotate(quarter_turns(dir0, dir), beside);
+    settle_on_edge(w, face, dir, beside);
+    return true;
+  }
+  bool find_wedge(int w, int& face, V2& dir) const {
     if (in_wedge(face, w, dir)) return true;
     const HH o0 = outgoing_in_face(w, face);
     const int degree = vertex_degree(w);

@@ -9,6 +9,7 @@
 
 #include "core/base/errors.h"
 #include "core/base/timing.h"
+#include "core/field/matching_repair.h"
 
 namespace qs {
 
@@ -132,16 +133,40 @@ void CrossFieldSolver::setup(const TriMesh& mesh, const GeometryCache& g, const 
   // The only factorization needed when no cluster contradicts the layout, made by the first
   // solve: in split mode the structural pass and the deviation release change the matrix
   // before it (one factorization for both).
-  drop_structural_conflicts(mesh, g, tolerated);
-  warm_start(g, /*allow_factorization=*/true, reference_rotation);
-  release_deviating_clusters(g);
-  solve(g);
-  drop_conflicting_clusters(mesh, g, tolerated);
+  settle_and_warm_start(mesh, g, tolerated, /*allow_factorization=*/true, reference_rotation);
   residual_mismatches_ = count_mismatches(g);
   field_.active_constraints = nc - field_.dropped_constraints;
+  repair_matching(g);
 }
 
 CrossFieldSolver::~CrossFieldSolver() = default;
+
+void CrossFieldSolver::settle_and_warm_start(const TriMesh& mesh, const GeometryCache& g,
+                                             int tolerated, bool allow_factorization,
+                                             const ReferenceRotation& reference_rotation) {
+  const bool structural =
+      drop_structural_conflicts(mesh, g, tolerated, allow_factorization, reference_rotation);
+  if (structural) {
+    // The feature and boundary clusters keep the rotations their pass settled; the curvature
+    // clusters start from the layout's own field (the warm start's reference), else from the
+    // field the feature and boundary constraints alone hold (the pass's last solve).
+    std::vector<char> curvature(field_.clusters, 0);
+    for (int k = 0; k < static_cast<int>(field_.constraints.face.size()); ++k)
+      if (is_curvature(k)) curvature[cluster_of_[k]] = 1;
+    const Eigen::VectorXd theta =
+        reference_theta_.size() == g.n_faces
+            ? reference_theta_
+            : Eigen::Map<const Eigen::VectorXd>(field_.theta.data(), g.n_faces);
+    round_clusters(constraint_angles(g), theta, &curvature);
+  } else {
+    warm_start(g, allow_factorization, reference_rotation);
+  }
+  release_deviating_clusters(g);
+  solve_system(g);
+  // After the structural pass only curvature clusters are released: the feature and boundary
+  // constraints it kept agree with the layout.
+  drop_conflicting_clusters(mesh, g, tolerated, /*curvature_only=*/structural);
+}
 
 void CrossFieldSolver::choose_arc_gauge(const TriMesh& mesh, const GeometryCache& g,
                                         const Layout& layout) {
@@ -424,7 +449,6 @@ void CrossFieldSolver::warm_start(const GeometryCache& g, bool allow_factorizati
   for (int cl = 0; cl < field_.clusters; ++cl)
     if (cluster_active_[cl] && (largest < 0 || cluster_size_[cl] > cluster_size_[largest]))
       largest = cl;
-  if (largest < 0) return;
   std::vector<int> others;  // active clusters whose rotation is relaxed
   std::vector<int> column(field_.clusters, -1);
   for (int cl = 0; cl < field_.clusters; ++cl)
@@ -486,6 +510,10 @@ void CrossFieldSolver::warm_start(const GeometryCache& g, bool allow_factorizati
                                    (field_.timings.reference_rotation_s - rotation_before);
     return;
   }
+  // (The layout's own field above is needed also when no cluster is in force: the structural
+  // pass may have released every feature and boundary cluster, and the curvature clusters are
+  // rounded against it.)
+  if (largest < 0) return;
   const bool relaxed = mode == ClusterWarmStart::Relaxed;
   if (!relaxed && !allow_factorization) return;
   std::fill(cluster_offset_.begin(), cluster_offset_.end(), 0);
@@ -545,7 +573,7 @@ int CrossFieldSolver::count_mismatches(const GeometryCache& g) const {
 }
 
 void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const GeometryCache& g,
-                                                 int tolerated) {
+                                                 int tolerated, bool curvature_only) {
   const int nf = g.n_faces;
   const int nc = static_cast<int>(field_.constraints.face.size());
   if (nc == 0 || options_.max_conflict_passes <= 0) return;
@@ -574,7 +602,7 @@ void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const Geom
     for (size_t head = 0; head < queue.size(); ++head) {
       const int f = queue[head];
       const int k = constraint_at_[f];
-      if (k >= 0 && active(k)) {
+      if (k >= 0 && active(k) && (!curvature_only || is_curvature(k))) {
         if (by_faces) {
           removed.push_back(k);
         } else if (!in_drop[cluster_of_[k]]) {
@@ -614,7 +642,7 @@ void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const Geom
     // The trial's solve re-rounds the cluster offsets: kept for the restore below.
     const std::vector<int> offsets_before = cluster_offset_;
     factorize_as_current();
-    solve(g);
+    solve_system(g);
     ++field_.timings.conflict_passes;
     const int now = count_mismatches(g);
     if (now >= mismatches) {
@@ -643,14 +671,14 @@ void CrossFieldSolver::drop_conflicting_clusters(const TriMesh& mesh, const Geom
       // 9.51 and 956; on a bunny cage layout the re-rounded one has 2 mismatches instead of 1.
       const std::vector<int> offsets_trial = cluster_offset_;
       cluster_offset_ = offsets_before;
-      solve(g);
+      solve_system(g);
       if (offsets_trial != offsets_before) {
         const int kept_mismatches = count_mismatches(g);
         const double kept_energy = energy(g);
         const CrossField kept = field_;
         const std::vector<int> kept_offsets = cluster_offset_;
         cluster_offset_ = offsets_trial;
-        solve(g);
+        solve_system(g);
         const int m = count_mismatches(g);
         if (m > kept_mismatches || (m == kept_mismatches && energy(g) >= kept_energy)) {
           field_ = kept;
@@ -677,9 +705,10 @@ bool CrossFieldSolver::structural_pass_applies() const {
   return any_structural && any_curvature;
 }
 
-void CrossFieldSolver::drop_structural_conflicts(const TriMesh& mesh, const GeometryCache& g,
-                                                 int tolerated) {
-  if (!structural_pass_applies()) return;
+bool CrossFieldSolver::drop_structural_conflicts(const TriMesh& mesh, const GeometryCache& g,
+                                                 int tolerated, bool allow_factorization,
+                                                 const ReferenceRotation& reference_rotation) {
+  if (!structural_pass_applies()) return false;
   const int nc = static_cast<int>(field_.constraints.face.size());
   // Curvature clusters in force (split mode: a cluster has constraints of one class only).
   std::vector<char> curvature(field_.clusters, 0);
@@ -736,7 +765,12 @@ void CrossFieldSolver::drop_structural_conflicts(const TriMesh& mesh, const Geom
   } else {
     factorize_as_current();
   }
-  solve(g);
+  // The rotations of the feature and boundary clusters start as in a run without curvature
+  // constraints: from their own warm start, not from the offsets left by an earlier layout or
+  // zero (which twisted the clusters of a boundary-aligned layout against each other, and the
+  // pass released them all).
+  warm_start(g, allow_factorization, reference_rotation);
+  solve_system(g);
   drop_conflicting_clusters(mesh, g, tolerated);
   if (current_) {  // the structural matrix after its drops, for the next pass
     structural_ = solver_;
@@ -772,6 +806,7 @@ void CrossFieldSolver::drop_structural_conflicts(const TriMesh& mesh, const Geom
   field_.gauge_face = gauge_before;
   gauge_angle_ = gauge_angle_before;
   recount_dropped_clusters();
+  return true;
 }
 
 double CrossFieldSolver::choose_reference_rotation(const Eigen::VectorXd& reference,
@@ -891,12 +926,14 @@ Eigen::VectorXd CrossFieldSolver::rhs(const GeometryCache& g, const std::vector<
   return b;
 }
 
-void CrossFieldSolver::round_clusters(const std::vector<double>& c, const Eigen::VectorXd& theta) {
+void CrossFieldSolver::round_clusters(const std::vector<double>& c, const Eigen::VectorXd& theta,
+                                      const std::vector<char>* only) {
   std::vector<double> sum(field_.clusters, 0.0), weight(field_.clusters, 0.0);
   for (size_t k = 0; k < c.size(); ++k) {
     if (!constraint_active_[k]) continue;  // released faces (a dropped cluster still rounds)
     const int f = field_.constraints.face[k];
     const int cl = cluster_of_[k];
+    if (only && !(*only)[cl]) continue;
     // Offset of the cluster rotation that best matches θ here, in quarter turns.
     sum[cl] += (theta(f) - c[k]) / kQuarter - relative_q_[k];
     weight[cl] += 1;
@@ -906,6 +943,21 @@ void CrossFieldSolver::round_clusters(const std::vector<double>& c, const Eigen:
 }
 
 const CrossField& CrossFieldSolver::solve(const GeometryCache& g) {
+  solve_system(g);
+  repair_matching(g);
+  return field_;
+}
+
+void CrossFieldSolver::repair_matching(const GeometryCache& g) {
+  // The faces the constraints in force (and the gauge) hold keep their θ.
+  std::vector<char> fixed(g.n_faces, 0);
+  for (size_t k = 0; k < field_.constraints.face.size(); ++k)
+    if (active(static_cast<int>(k))) fixed[field_.constraints.face[k]] = 1;
+  if (field_.gauge_face >= 0) fixed[field_.gauge_face] = 1;
+  repair_principal_matching(g, field_.period_jump, fixed, field_.theta);
+}
+
+const CrossField& CrossFieldSolver::solve_system(const GeometryCache& g) {
   if (g.n_faces != matrix_.rows())
     throw InvalidInputError("cross field: the geometry has " + std::to_string(g.n_faces) +
                             " faces, the solver was built for " + std::to_string(matrix_.rows()));
@@ -982,17 +1034,14 @@ const CrossField& CrossFieldSolver::update_layout(const TriMesh& mesh, const Geo
     field_.dropped_clusters = 0;
     field_.gauge_face = full_gauge_face_;
   }
-  drop_structural_conflicts(mesh, g, residual_mismatches_);
-  warm_start(g, /*allow_factorization=*/false);
-  release_deviating_clusters(g);
-  solve(g);
   // Clusters that contradict the new layout (steps across edges that disagree with the new
   // period jumps) are dropped as in the constructor; this factorizes only when there are any.
   // As many mismatches as the constructor's passes left (the smoothest field itself turns by
   // more than 45° there) are tolerated: a pass would not remove them.
-  drop_conflicting_clusters(mesh, g, residual_mismatches_);
+  settle_and_warm_start(mesh, g, residual_mismatches_, /*allow_factorization=*/false);
   field_.active_constraints =
       static_cast<int>(field_.constraints.face.size()) - field_.dropped_constraints;
+  repair_matching(g);
   return field_;
 }
 

@@ -120,6 +120,9 @@ struct CrossField {
 };
 
 //! Stateful solver: builds constraints, period jumps and the factorized matrix once. The
+//! returned field is the smoothest one, except around edges where that one turns by more than
+//! 45° against its period jump: there it is smoothed until its principal matching is the
+//! period jumps (repair_matching), so its singularities are exactly the layout's. The
 //! matrix depends on neither the geometry nor the period jumps, only on the set of active
 //! constraints: `solve` after vertices moved and `update_layout` after nodes moved to other
 //! vertices (new period jumps) only back-substitute with the existing factorization.
@@ -154,8 +157,13 @@ class CrossFieldSolver {
   //! Solves for θ with the current geometry (reuses the factorization). \p geometry must be the
   //! construction's cache continued by update_geometry (same connectivity, κ continued), so that
   //! the period jumps stay valid. The constraint directions are the original 3D directions,
-  //! projected onto the current faces.
+  //! projected onto the current faces. As after the constructor and update_layout, the field's
+  //! principal matching is then repaired (repair_matching).
   const CrossField& solve(const GeometryCache& geometry);
+  //! Interior edges where the smoothest field of the last constructor or set-up turned by more
+  //! than 45° against its period jump after the conflict passes (before repair_matching): the
+  //! mismatches update_layout's passes tolerate.
+  int residual_mismatches() const { return residual_mismatches_; }
   //! After the layout changed on the same mesh connectivity (nodes moved to other vertices,
   //! arcs rerouted, vertices relocated): collects the constraints of the current geometry and
   //! layout as the constructor does (curvature recomputed). When they are on the same faces
@@ -234,15 +242,27 @@ class CrossFieldSolver {
   //! (rotation_anchor_: update_layout keeps the rotation as nodes move), else 0.
   double choose_reference_rotation(const Eigen::VectorXd& reference,
                                    const ReferenceRotation& reference_rotation);
-  void round_clusters(const std::vector<double>& c, const Eigen::VectorXd& theta);
+  //! Each cluster's offset that best matches \p theta (per face) at its constraints in force;
+  //! with \p only (per cluster) only the clusters it flags.
+  void round_clusters(const std::vector<double>& c, const Eigen::VectorXd& theta,
+                      const std::vector<char>* only = nullptr);
   //! arc_gauge_face_ and arc_gauge_angle_ for \p layout (-1 / 0 without arcs).
   void choose_arc_gauge(const TriMesh& mesh, const GeometryCache& geometry, const Layout& layout);
   //! Drop passes while more than \p tolerated edges mismatch (update_layout tolerates the
-  //! ones the passes could not remove before).
+  //! ones the passes could not remove before). With \p curvature_only only curvature
+  //! constraints are released (after the structural pass settled the others).
   void drop_conflicting_clusters(const TriMesh& mesh, const GeometryCache& geometry,
-                                 int tolerated = 0);
-  //! Split mode (max_cluster_faces > 0): the conflict passes for the feature and boundary
-  //! clusters alone, as a run without curvature constraints does them, before the curvature
+                                 int tolerated = 0, bool curvature_only = false);
+  //! The common end of setup and update_layout: the structural pass (when it applies, with the
+  //! warm start of the feature and boundary clusters inside it; the curvature clusters then
+  //! start from the layout's own field), else the warm start; the deviation release, the solve
+  //! and the conflict passes (curvature clusters only after a structural pass).
+  void settle_and_warm_start(const TriMesh& mesh, const GeometryCache& geometry, int tolerated,
+                             bool allow_factorization,
+                             const ReferenceRotation& reference_rotation = {});
+  //! Split mode (max_cluster_faces > 0): the warm start and the conflict passes for the
+  //! feature and boundary clusters alone, as a run without curvature constraints does them
+  //! (warm_start with \p allow_factorization and \p reference_rotation), before the curvature
   //! clusters come back into force (one factorization per pass; the next solve factorizes the
   //! matrix with the curvature constraints back, with no pass the full one). Otherwise
   //! the curvature clusters next to a feature or boundary cluster that contradicts the layout were
@@ -251,7 +271,10 @@ class CrossFieldSolver {
   //! dropped (structural_dropped_): they are dropped again at once, and passes run only while
   //! more edges mismatch than \p tolerated (on the 70K bunny 1730 of 1750 feature faces are
   //! dropped every descent step: one pass-free factorization instead of four to six).
-  void drop_structural_conflicts(const TriMesh& mesh, const GeometryCache& geometry, int tolerated);
+  //! Returns whether the pass ran (structural_pass_applies).
+  bool drop_structural_conflicts(const TriMesh& mesh, const GeometryCache& geometry, int tolerated,
+                                 bool allow_factorization,
+                                 const ReferenceRotation& reference_rotation = {});
   //! Whether drop_structural_conflicts runs its passes with every constraint in force.
   bool structural_pass_applies() const;
   //! Releases the curvature clusters that deviate from the layout's own field
@@ -260,6 +283,15 @@ class CrossFieldSolver {
   void release_deviating_clusters(const GeometryCache& geometry);
   //! Interior edges whose principal matching differs from the period jump.
   int count_mismatches(const GeometryCache& geometry) const;
+  //! The linear solve and cluster rounding of solve(), without the repair (the passes'
+  //! solves, which judge the constraints by the smoothest field's mismatches).
+  const CrossField& solve_system(const GeometryCache& geometry);
+  //! The last step of every public solve: where the smoothest field turns by more than 45°
+  //! across an edge against its period jump, θ is smoothed around that edge
+  //! (repair_principal_matching; faces of constraints in force and the gauge face held), so the
+  //! singularities measured on the field alone (field_quarter_indices) are the period jumps'
+  //! (the layout's irregular nodes).
+  void repair_matching(const GeometryCache& geometry);
   //! The energy the solve minimizes, at field_.theta: Σ over interior edges of the squared
   //! step against transport and period jump, plus λ·(θ_f − target)² on the constraints in force
   //! (current cluster offsets) and on the gauge face.
