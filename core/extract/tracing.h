@@ -1,4 +1,4 @@
-// Embedding extraction (paper §5.2, algorithm.md §5.1): every arc is traced as an iso-line of
+// Embedding extraction (paper §5.2; docs/design.md, "Tracing"): every arc is traced as an iso-line of
 // the parameterization from its start node, across transitions, with exact vertex handling;
 // then the traced base complex is compared with the input layout.
 #pragma once

@@ -81,7 +81,7 @@ void CrossFieldSolver::setup(const TriMesh& mesh, const GeometryCache& g, const 
 
   // Clusters: constrained faces connected through the constrained faces and the faces touching
   // boundary/feature curves (the "ring" that carries the angle between alternating constrained
-  // faces, algorithm.md §3.2).
+  // faces, docs/design.md, "Cross field").
   constraint_at_.assign(nf, -1);
   for (int k = 0; k < nc; ++k) constraint_at_[field_.constraints.face[k]] = k;
   carrier_.assign(nf, 0);
@@ -248,7 +248,7 @@ Eigen::VectorXd CrossFieldSolver::back_substitute(const Eigen::VectorXd& b) {
 namespace {
 
 // Quarter turns of the boundary constraints on the boundary loops that layout arcs cover
-// entirely (aligned boundaries, algorithm.md §3.2), as the layout prescribes them.
+// entirely (aligned boundaries, docs/design.md, "Cross field"), as the layout prescribes them.
 //
 // Rounding each constraint against the angle carried to it (propagate_clusters' rule) lets the
 // field follow the tangent through smooth stretches and keep its direction through sharp
@@ -383,7 +383,7 @@ void CrossFieldSolver::propagate_clusters(const TriMesh& mesh, const GeometryCac
   queue.reserve(nf);
   const bool split = options_.max_cluster_faces > 0;
   // Split mode, first the feature and boundary clusters (their rings carry the angle between
-  // their constraints, algorithm.md §3.2, also across faces with curvature constraints), then
+  // their constraints, docs/design.md, "Cross field", also across faces with curvature constraints), then
   // the curvature clusters over the curvature-constrained faces, each of at most
   // max_cluster_faces faces. Otherwise one pass: connected regions of every kind.
   for (int phase = 0; phase < (split ? 2 : 1); ++phase) {
@@ -1000,8 +1000,7 @@ const CrossField& CrossFieldSolver::update_layout(const TriMesh& mesh, const Geo
     // constructor does; the analyses (same pattern) and the reference factorization are kept.
     // Its drop passes tolerate as many mismatching edges as the previous solve left, as the
     // same-face path below does: a pass would not remove them, and each costs a factorization.
-    // (Session 5: on the 70K bunny 25 steps end at E 0.0354 instead of 0.0405, fewer
-    // factorizations; a fresh construction drops until a pass stops helping.)
+    // (A fresh construction drops until a pass stops helping.)
     setup(mesh, g, layout, topology, std::move(constraints), residual_mismatches_, {},
           period_jumps);
     return field_;

@@ -1,4 +1,4 @@
-// Smoothest cross field with the layout's topology (paper §4.2, algorithm.md §3):
+// Smoothest cross field with the layout's topology (paper §4.2; docs/design.md, "Cross field"):
 // min Σ_e (θ_i + κ_ij + (π/2)p_ij − θ_j)² + λ Σ_{f∈C} (θ_f − c_f − (π/2)q_f)², with the
 // period jumps p fixed by the layout and the integer constraint rotations q chosen per
 // cluster. The matrix depends on neither geometry nor q: it is factorized once.
@@ -16,7 +16,7 @@
 
 namespace qs {
 
-//! How the integer rotations of the constraint clusters are initialized (algorithm.md §3.2).
+//! How the integer rotations of the constraint clusters are initialized (docs/design.md, "Cross field").
 enum class ClusterWarmStart {
   //! Relax every cluster rotation to a real number, minimize the energy jointly with θ (the
   //! factorized field matrix plus one multi-right-hand-side solve, no extra factorization),
@@ -68,10 +68,8 @@ struct CrossFieldOptions {
   //! clusters are released only where they contradict the layout. At 10 the aligned E° falls
   //! below --no-align's on 14 of 16 test layouts (cage layouts, QuadWild and own quads, the
   //! conjugate-direction layout of inspired_mesh; a few % above it on two coarse animal cages),
-  //! and the rocker-arm cage layout embeds only so. Default since session 16, when the
-  //! descent's field updates got cheap enough (update_layout starts the structural pass from its
-  //! last drops; the 70K bunny's 25 descent steps: 25 s against 23 s with whole regions, and a
-  //! final E 29 % lower). 0: whole regions. docs/benchmarks.md, sessions 14–16.
+  //! and the rocker-arm cage layout embeds only so (docs/benchmarks.md, "Design measurements").
+  //! 0: whole regions.
   //! (`--max-cluster-faces`)
   int max_cluster_faces = 10;
   //! Split mode: a curvature cluster whose targets deviate from the layout's own field (the

@@ -1,6 +1,6 @@
 // Principal curvature directions per face (normal-cycle tensor) and the direction constraints
 // that guide the cross field: reliable curvature regions, sharp features and boundaries
-// (paper §4.2, algorithm.md §2).
+// (paper §4.2; docs/design.md, "Curvature constraints").
 #pragma once
 
 #include <Eigen/Core>

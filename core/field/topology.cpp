@@ -16,7 +16,7 @@ namespace qs {
 namespace {
 
 // Sign of the ccw step around v across edge e = {v, b}: +1 iff it runs along the dual edge's
-// canonical orientation, i.e. iff b < v (algorithm.md §1.3).
+// canonical orientation, i.e. iff b < v (docs/design.md, "Field topology").
 int ccw_sign(const GeometryCache& g, int e, int v) {
   const auto [a, b] = g.edge_vertices[e];
   const int other = (a == v) ? b : a;
@@ -156,7 +156,7 @@ std::vector<std::vector<std::pair<int, bool>>> layout_fundamental_cycles(
 
 namespace {
 
-// One layout cycle turned into an equation Σ_Γ sign·p_e = rhs (algorithm.md §1.3).
+// One layout cycle turned into an equation Σ_Γ sign·p_e = rhs (docs/design.md, "Field topology").
 struct CycleEquation {
   std::vector<std::pair<int, int>> terms;  // (edge, sign)
   long rhs = 0;
@@ -507,9 +507,8 @@ std::vector<int> compute_period_jumps(const TriMesh& mesh, const GeometryCache& 
   // Gauss–Bonnet leaves one loop of a sphere with holes to the others: the shortest loops are
   // taken first, so that the longest one (a disk's outer boundary) is the one determined. Each
   // is added only where it raises the rank, so it never overrides what the layout implies.
-  // (Until session 23 every free loop wrapped, the shorter ones not first: the mask with arcs
-  // into both free eye holes then folded around the eyes, E 31454 with 45 fold-overs; capped,
-  // E 2752 and none.)
+  // (Wrapping every free loop folds the mask with arcs into both free eye holes around the eyes;
+  // capped, it embeds.)
   if (nfree > 0 && rank_of(rows) < nfree) {
     std::vector<char> node_vertex(nv, 0);
     for (const auto& n : layout.nodes) node_vertex[n.vertex] = 1;

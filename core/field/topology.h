@@ -1,4 +1,4 @@
-// Cross-field topology fixed by the layout (paper §4.1, algorithm.md §1.3): integer period
+// Cross-field topology fixed by the layout (paper §4.1; docs/design.md, "Field topology"): integer period
 // jumps on dual edges such that every irregular node's vertex has index (4 − valence)/4, every
 // other interior vertex index 0, and every layout cycle (hence every homology generator and
 // boundary loop) the turning number the layout implies. Exact integer construction by
@@ -36,8 +36,7 @@ enum class FreeLoopTurning {
   //! iso-lines run on across the hole (one or a few arcs into a hole; the default).
   kCap,
   //! Like the loop's tangent, as along an aligned boundary: the iso-lines wrap around the hole,
-  //! an O-grid around it (many arcs radiating into a hub). Every free loop did this until
-  //! session 23 (then in the order the loops were listed, not shortest first).
+  //! an O-grid around it (many arcs radiating into a hub).
   kWrap,
 };
 
