@@ -21,6 +21,7 @@
 #include "app/gui/plot_ticks.h"
 #include "app/gui/ui_text.h"
 #include "core/layout/layout_io.h"
+#include "tests/scoped_env.h"
 #ifdef QS_TEST_RENDER
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>  // key codes only
@@ -38,39 +39,13 @@ const fs::path kAssets = QS_ASSETS_DIR;
 const fs::path kExampleMesh = kAssets / "example" / "ellipsoid.obj";
 const fs::path kExampleLayout = kAssets / "example" / "ellipsoid.layout.json";
 
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const std::string& value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    setenv(name, value.c_str(), 1);
-  }
-  ~ScopedEnv() {
-    if (old_)
-      setenv(name_, old_->c_str(), 1);
-    else
-      unsetenv(name_);
-  }
-
- private:
-  const char* name_;
-  std::optional<std::string> old_;
-};
-
 // Every test gets its own home, config and autosave folders (the editor autosaves every edit).
 class GuiEditor : public ::testing::Test {
  protected:
   GuiEditor()
-      : dir_(fs::temp_directory_path() /
-             ("qs_gui_editor_" + std::to_string(::getpid()) + "_" +
-              ::testing::UnitTest::GetInstance()->current_test_info()->name())),
-        home_("HOME", (dir_ / "home").string()),
-        config_("XDG_CONFIG_HOME", (dir_ / "config").string()),
-        autosave_("QS_AUTOSAVE_DIR", (dir_ / "autosave").string()) {
+      : sandbox_("qs_gui_editor", ::testing::UnitTest::GetInstance()->current_test_info()->name()),
+        dir_(sandbox_.dir()) {
     fs::create_directories(dir_ / "home" / "Documents");
-  }
-  ~GuiEditor() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
   }
   static EditorConfig config() {
     EditorConfig c;
@@ -96,8 +71,8 @@ class GuiEditor : public ::testing::Test {
     return s && (s->status == WorkerStatus::Finished || s->status == WorkerStatus::Failed);
   }
 
-  fs::path dir_;
-  ScopedEnv home_, config_, autosave_;
+  test::EditorSandbox sandbox_;
+  const fs::path dir_;
 };
 
 TEST_F(GuiEditor, ArcPinnedDuringARunGoesToTheRunWhichGoesOn) {

@@ -21,6 +21,7 @@
 #include "core/layout/symmetry.h"
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_io.h"
+#include "tests/scoped_env.h"
 #ifdef QS_TEST_RENDER
 #include "render/guide_layer.h"
 #endif
@@ -35,40 +36,12 @@ const fs::path kAssets = QS_ASSETS_DIR;
 const fs::path kExampleMesh = kAssets / "example" / "ellipsoid.obj";
 const fs::path kExactLayout = kAssets / "example" / "ellipsoid_exact.layout.json";
 
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const std::string& value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    setenv(name, value.c_str(), 1);
-  }
-  ~ScopedEnv() {
-    if (old_)
-      setenv(name_, old_->c_str(), 1);
-    else
-      unsetenv(name_);
-  }
-
- private:
-  const char* name_;
-  std::optional<std::string> old_;
-};
-
 // Own home, config and autosave folders (the editor autosaves every edit).
 class GuiSketch : public ::testing::Test {
  protected:
   GuiSketch()
-      : dir_(fs::temp_directory_path() /
-             ("qs_gui_sketch_" + std::to_string(::getpid()) + "_" +
-              ::testing::UnitTest::GetInstance()->current_test_info()->name())),
-        home_("HOME", (dir_ / "home").string()),
-        config_("XDG_CONFIG_HOME", (dir_ / "config").string()),
-        autosave_("QS_AUTOSAVE_DIR", (dir_ / "autosave").string()) {
-    fs::create_directories(dir_ / "home");
-  }
-  ~GuiSketch() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
+      : sandbox_("qs_gui_sketch", ::testing::UnitTest::GetInstance()->current_test_info()->name()),
+        dir_(sandbox_.dir()) {}
   static EditorConfig config() {
     EditorConfig c;
     c.assets_dir = kAssets.string();
@@ -94,8 +67,8 @@ class GuiSketch : public ::testing::Test {
     ASSERT_TRUE(poll_until(editor, [&] { return editor.mirror() != nullptr; }));
   }
 
-  fs::path dir_;
-  ScopedEnv home_, config_, autosave_;
+  test::EditorSandbox sandbox_;
+  const fs::path dir_;
 };
 
 const TriMesh& mesh_of(const Editor& editor) {

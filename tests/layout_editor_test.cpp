@@ -18,6 +18,7 @@
 #include "core/base/atomic_file.h"
 #include "core/layout/layout_io.h"
 #include "core/layout/validate.h"
+#include "tests/scoped_env.h"
 
 namespace qs::app {
 namespace {
@@ -449,23 +450,7 @@ TEST(LayoutEditorClosed, DanglingArcsNeedABoundary) {
   EXPECT_NE(error.find("boundary"), std::string::npos) << error;
 }
 
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const std::string& value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    setenv(name, value.c_str(), 1);
-  }
-  ~ScopedEnv() {
-    if (old_)
-      setenv(name_, old_->c_str(), 1);
-    else
-      unsetenv(name_);
-  }
-
- private:
-  const char* name_;
-  std::optional<std::string> old_;
-};
+using test::ScopedEnv;
 
 fs::path fresh_dir(const std::string& name) {
   const fs::path dir =
