@@ -5,6 +5,7 @@
 #include <iostream>
 #include <new>
 
+#include "app/cli/validators.h"
 #include "app/gui/app.h"
 #include "core/base/allocator.h"
 
@@ -48,7 +49,7 @@ int run_editor(int argc, char** argv) {
   cli.add_option("--motion-resolution", options.motion_resolution,
                  "Resolution scale of the 3D view while the camera moves, 0.25-1 (default 0.5; "
                  "used without multisampling only; 1: always full resolution)")
-      ->check(CLI::Range(0.25f, 1.0f));
+      ->check(qs::cli::finite_in(0.25, 1.0));
   cli.add_option("--worker-nice", options.worker_nice,
                  "Nice value of the solver threads, 0-19 (default 10: the UI wins the CPU; 0 "
                  "leaves their priority alone)")
@@ -63,7 +64,12 @@ int run_editor(int argc, char** argv) {
                  "Automation: write the editor's state as JSON to this file at exit");
   cli.add_option("--width", options.width, "Window width")->check(CLI::Range(200, 8192));
   cli.add_option("--height", options.height, "Window height")->check(CLI::Range(200, 8192));
-  CLI11_PARSE(cli, argc, argv);
+  try {
+    cli.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = cli.exit(e);  // prints the message (or --help)
+    return code == 0 ? 0 : 1;      // a malformed or out-of-range option: exit code 1
+  }
   qs::app::App app(std::move(options));
   activity = "running the editor";
   return app.run();

@@ -162,5 +162,9 @@ add_test(NAME gui_bad_mesh_exits_2
 add_test(NAME gui_missing_mesh_exits_2
   COMMAND gui_smoke_check exit-code --app $<TARGET_FILE:quadsketch> --expect 2 --
     --mesh ${QS_GUI_SMOKE_DIR}/does_not_exist.obj --quit)
-set_tests_properties(gui_bad_mesh_exits_2 gui_missing_mesh_exits_2 PROPERTIES
-  TIMEOUT 60 ENVIRONMENT "${QS_GUI_TEST_ENV}")
+# A NaN or out-of-range numeric option: exit code 1 with the option named.
+add_test(NAME gui_nan_option_exits_1
+  COMMAND gui_smoke_check exit-code --app $<TARGET_FILE:quadsketch> --expect 1 --
+    --motion-resolution nan --quit)
+set_tests_properties(gui_bad_mesh_exits_2 gui_missing_mesh_exits_2 gui_nan_option_exits_1
+  PROPERTIES TIMEOUT 60 ENVIRONMENT "${QS_GUI_TEST_ENV}")
