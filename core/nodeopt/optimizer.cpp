@@ -220,10 +220,11 @@ struct NodeOptimizer::Impl {
   int fewest_folds_count = 0;
   // The start (NodeOptOptions::initial_fallback): the last fallback of the fold-over removal.
   std::unique_ptr<State> initial_state;
-  // The fold-free accepted states with the lowest E (the initial state included), by E: the
-  // candidates of the result rule in finish(). At most kFoldFreeKept.
+  // The candidates of the result rule in finish(), by E: the initial state when it is
+  // fold-free (always kept), and the kFoldFreeKept fold-free accepted states with the lowest E.
   static constexpr size_t kFoldFreeKept = 4;
   std::vector<std::pair<double, std::shared_ptr<const State>>> fold_free;
+  std::pair<double, std::shared_ptr<const State>> fold_free_initial;
   int phase_halvings = 0;
   int stalled_steps = 0;      // accepted steps in a row with a gain below stall_gain
   double accepted_alpha = 0;  // α of the phase's last accepted descent step (0: none yet)
@@ -288,7 +289,7 @@ struct NodeOptimizer::Impl {
       options.param.vertex_order = current.pipeline->options().param.vertex_order;
     }
     fewest_folds_count = current.foldovers;
-    note_fold_free();
+    note_fold_free(/*initial=*/true);
     result.E_init = current.E;
     result.foldovers_init = current.foldovers;
     StepReport r;
@@ -492,8 +493,12 @@ struct NodeOptimizer::Impl {
 
   // The current (just accepted) state, when it has no fold-over and is among the
   // kFoldFreeKept lowest E of the fold-free states so far: a candidate for the result rule.
-  void note_fold_free() {
+  void note_fold_free(bool initial = false) {
     if (current.foldovers > 0) return;
+    if (initial) {
+      fold_free_initial = {current.E, std::make_shared<const State>(state)};
+      return;
+    }
     if (fold_free.size() >= kFoldFreeKept && current.E >= fold_free.back().first) return;
     auto at = std::upper_bound(fold_free.begin(), fold_free.end(), current.E,
                                [](double e, const auto& c) { return e < c.first; });
@@ -1190,8 +1195,8 @@ struct NodeOptimizer::Impl {
       out.E_final = ev.E;
       out.foldovers_final = ev.foldovers;
 
-      // Fold-over removal: strict orientation constraints in the last solve (docs/design.md, "Orientation constraints"),
-      // stiffening (§7.1) only as the fallback when fold-overs remain.
+      // Fold-over removal: strict orientation constraints in the last solve (docs/design.md,
+      // "Orientation constraints"), stiffening (§7.1) only as the fallback when fold-overs remain.
       const bool at_this_state =
           no.orientation_at_moved_states || (initial_state && same_state(*initial_state, st_in));
       if (no.orientation_at_end && ev.foldovers > 0 && at_this_state) {
@@ -1371,7 +1376,13 @@ struct NodeOptimizer::Impl {
                            result.pipeline && result.pipeline->extract().structurally_equivalent);
     std::shared_ptr<const State> taken;
     Evaluation taken_ev;
-    for (const auto& [E, candidate] : fold_free) {
+    std::vector<std::pair<double, std::shared_ptr<const State>>> candidates = fold_free;
+    if (fold_free_initial.second) {
+      candidates.push_back(fold_free_initial);
+      std::stable_sort(candidates.begin(), candidates.end(),
+                       [](const auto& a, const auto& b) { return a.first < b.first; });
+    }
+    for (const auto& [E, candidate] : candidates) {
       if (result_rank == 2 && E >= result.E_final) break;
       if (same_state(*candidate, state)) continue;
       check_cancel(observer);
