@@ -95,8 +95,8 @@ TEST(Boundary, MaskWithArcsIntoBothEyes) {
   for (size_t i = 0; i < layout.arcs.size(); ++i)
     EXPECT_GE(layout.arcs[i].path.size(), 2u) << "could not route arc " << i;
   // Free eye holes: the field turns around each as around a regular point (the iso-lines run on
-  // across the hole), so nothing folds. Before the free-hole rule it turned like the eyes' tangents and
-  // the iso-lines wrapped around them: E 31454 and 45 fold-overs (unaligned), 97 (aligned).
+  // across the hole), so nothing folds. Before the free-hole rule it turned like the eyes' tangents
+  // and the iso-lines wrapped around them: E 31454 and 45 fold-overs (unaligned), 97 (aligned).
   expect_embedding(mesh, layout, 2, /*aligned=*/false, 0.0);
   expect_embedding(mesh, layout, 2, /*aligned=*/true);
 }

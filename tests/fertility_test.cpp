@@ -134,12 +134,12 @@ TEST(Fertility, FieldIndicesAreTheLayoutsAndSumToEuler) {
 
 // Issue #4: the embedding traced on the parameterization (--no-node-opt). Disabled: with the
 // cage's own node positions the parameterization folds (664–2304 fold-overs, 237 nodes with a
-// wrong cone angle), so the traced layout is not structurally equivalent; the simplified cage layout (above)
-// folds less (504 aligned, 750 --no-align) but is not equivalent either. After node optimization
-// the simplified layout embeds (fertility_optimize_test.cpp: 0 fold-overs, structurally
-// equivalent); the plain one keeps about 600 fold-overs (65 wrongly winding nodes). The layout
-// the optimization makes, read back on the original mesh, embeds with fixed nodes once the
-// parameterization has orientation constraints (fertility_optimize_test.cpp); the cage's own
+// wrong cone angle), so the traced layout is not structurally equivalent; the simplified cage
+// layout (above) folds less (504 aligned, 750 --no-align) but is not equivalent either. After node
+// optimization the simplified layout embeds (fertility_optimize_test.cpp: 0 fold-overs,
+// structurally equivalent); the plain one keeps about 600 fold-overs (65 wrongly winding nodes).
+// The layout the optimization makes, read back on the original mesh, embeds with fixed nodes once
+// the parameterization has orientation constraints (fertility_optimize_test.cpp); the cage's own
 // positions stay infeasible for them. Run with --gtest_also_run_disabled_tests to see the numbers.
 TEST(Fertility, DISABLED_ParameterizationEmbedsTheLayout) {
   QS_FERTILITY_OR_SKIP(f);

@@ -1,4 +1,5 @@
-// Quality metrics (docs/design.md, "Metrics"): degenerate parametric images must not dominate E_confor.
+// Quality metrics (docs/design.md, "Metrics"): degenerate parametric images must not dominate
+// E_confor.
 #include "core/extract/metrics.h"
 
 #include <gtest/gtest.h>

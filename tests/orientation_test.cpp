@@ -1,7 +1,7 @@
-// Fold-over removal by strict orientation constraints (issue #5 item 6, docs/design.md, "Orientation constraints"):
-// the tri-sector QP solver on small hand-made problems, the constrained parameterization on a
-// folding synthetic layout (equality constraints still exact), the node optimizer's final solve
-// on the bundled example and on real layouts.
+// Fold-over removal by strict orientation constraints (issue #5 item 6, docs/design.md,
+// "Orientation constraints"): the tri-sector QP solver on small hand-made problems, the constrained
+// parameterization on a folding synthetic layout (equality constraints still exact), the node
+// optimizer's final solve on the bundled example and on real layouts.
 #include "core/param/orientation.h"
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
-// Curl-reducing sizing field (core/param/sizing.h, docs/design.md, "Sizing field") and its use in the
-// parameterization, the node-gradient estimator and the command line.
+// Curl-reducing sizing field (core/param/sizing.h, docs/design.md, "Sizing field") and its use in
+// the parameterization, the node-gradient estimator and the command line.
 #include "core/param/sizing.h"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
-// Embedding extraction (paper §5.2; docs/design.md, "Tracing"): every arc is traced as an iso-line of
-// the parameterization from its start node, across transitions, with exact vertex handling;
-// then the traced base complex is compared with the input layout.
+// Embedding extraction (paper §5.2; docs/design.md, "Tracing"): every arc is traced as an iso-line
+// of the parameterization from its start node, across transitions, with exact vertex handling; then
+// the traced base complex is compared with the input layout.
 #pragma once
 
 #include <array>

@@ -383,8 +383,8 @@ void CrossFieldSolver::propagate_clusters(const TriMesh& mesh, const GeometryCac
   queue.reserve(nf);
   const bool split = options_.max_cluster_faces > 0;
   // Split mode, first the feature and boundary clusters (their rings carry the angle between
-  // their constraints, docs/design.md, "Cross field", also across faces with curvature constraints), then
-  // the curvature clusters over the curvature-constrained faces, each of at most
+  // their constraints, docs/design.md, "Cross field", also across faces with curvature
+  // constraints), then the curvature clusters over the curvature-constrained faces, each of at most
   // max_cluster_faces faces. Otherwise one pass: connected regions of every kind.
   for (int phase = 0; phase < (split ? 2 : 1); ++phase) {
     const bool curvature_phase = split && phase == 1;

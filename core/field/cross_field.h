@@ -16,7 +16,8 @@
 
 namespace qs {
 
-//! How the integer rotations of the constraint clusters are initialized (docs/design.md, "Cross field").
+//! How the integer rotations of the constraint clusters are initialized (docs/design.md, "Cross
+//! field").
 enum class ClusterWarmStart {
   //! Relax every cluster rotation to a real number, minimize the energy jointly with θ (the
   //! factorized field matrix plus one multi-right-hand-side solve, no extra factorization),

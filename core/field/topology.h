@@ -1,6 +1,6 @@
-// Cross-field topology fixed by the layout (paper §4.1; docs/design.md, "Field topology"): integer period
-// jumps on dual edges such that every irregular node's vertex has index (4 − valence)/4, every
-// other interior vertex index 0, and every layout cycle (hence every homology generator and
+// Cross-field topology fixed by the layout (paper §4.1; docs/design.md, "Field topology"): integer
+// period jumps on dual edges such that every irregular node's vertex has index (4 − valence)/4,
+// every other interior vertex index 0, and every layout cycle (hence every homology generator and
 // boundary loop) the turning number the layout implies. Exact integer construction by
 // tree–cotree elimination; no rounding of geometric angles.
 #pragma once
