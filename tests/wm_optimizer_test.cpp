@@ -29,10 +29,11 @@ void expect_exact_surface(const WorkingMesh& w) {
 TEST(WmOptimizer, BundledSketchEmbedsWithExactNodeMoves) {
   const auto ex = test::ellipsoid_example();
   const WmResult r = optimize_working_layout(embedded(ex.mesh, ex.layout), PipelineOptions{});
-  std::printf("[stat] example: E %.6g -> %.6g (%s), fold-overs %d -> %d, %d steps (%d accepted), "
-              "working mesh %.3fx, %.1f s\n",
-              r.E_init, r.E_final, r.chosen.c_str(), r.foldovers_init, r.foldovers_final, r.steps,
-              r.accepted, r.state->mesh.growth(), r.time_s);
+  std::printf(
+      "[stat] example: E %.6g -> %.6g (%s), fold-overs %d -> %d, %d steps (%d accepted), "
+      "working mesh %.3fx, %.1f s\n",
+      r.E_init, r.E_final, r.chosen.c_str(), r.foldovers_init, r.foldovers_final, r.steps,
+      r.accepted, r.state->mesh.growth(), r.time_s);
   EXPECT_EQ(r.foldovers_final, 0);
   ASSERT_TRUE(r.pipeline);
   EXPECT_TRUE(r.pipeline->extract().structurally_equivalent);

@@ -81,8 +81,8 @@ std::vector<int> route_arc(WorkingMesh& mesh, LayoutOccupancy& occupancy,
 //! of that edge when the crossing is within \p snap (fraction of the edge) of it. Only free
 //! vertices and free edges are used (\p occupancy, synced, not marked). Returns the vertex path
 //! (source first), or an empty path when the line meets (or passes within the snap distance of)
-//! an occupied vertex, an arc edge or the boundary, or strays (the splits made until then stay: free
-//! refinement vertices, logged like route_arc's in \p split_log).
+//! an occupied vertex, an arc edge or the boundary, or strays (the splits made until then stay:
+//! free refinement vertices, logged like route_arc's in \p split_log).
 std::vector<int> route_straight(WorkingMesh& mesh, LayoutOccupancy& occupancy, int source,
                                 int target, double snap = 0.15, int* splits = nullptr,
                                 std::vector<std::array<int, 3>>* split_log = nullptr);

@@ -50,7 +50,7 @@ struct WmResult {
   std::optional<MeshLayout> state;  //!< the returned working mesh and layout on it (set by finish)
   //! Solved at `state` (with the orientation constraints when orientation_constraints).
   std::shared_ptr<Pipeline> pipeline;
-  bool orientation_constraints = false;   //!< the returned solve uses them
+  bool orientation_constraints = false;    //!< the returned solve uses them
   OrientationOptions orientation_options;  //!< the options of that solve
   OrientationReport orientation;           //!< of the last orientation-constrained solve run
   double E_init = 0, E_descent = 0, E_final = 0;
@@ -95,7 +95,6 @@ class WmOptimizer {
 
 //! Runs the whole optimization (step until over, then finish).
 WmResult optimize_working_layout(MeshLayout start, const PipelineOptions& options,
-                                 const WmOptions& node_options = {},
-                                 Observer* observer = nullptr);
+                                 const WmOptions& node_options = {}, Observer* observer = nullptr);
 
 }  // namespace qs
