@@ -19,9 +19,9 @@ int run_validate(const ValidateOptions& o, const CommonOptions& common) {
   if (!o.out.empty()) require_writable_folder(o.out);
   set_activity("loading the mesh '" + o.mesh + "'");
   MeshReport report;
-  const TriMesh input = load_mesh(o.mesh, &report);
+  TriMesh input = load_mesh(o.mesh, &report);
   for (const auto& w : report.warnings) std::cerr << "warning: " << o.mesh << ": " << w << "\n";
-  const SurfaceLayout on_surface = load_command_layout(o.layout, input);
+  const SurfaceLayout on_surface = load_command_layout(o.layout, std::move(input));
   const TriMesh& mesh = on_surface.mesh;
   const Layout& layout = on_surface.layout;
   set_activity("validating the layout '" + o.layout + "'");

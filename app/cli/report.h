@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "app/cli/activity.h"
 #include "app/cli/signals.h"
@@ -56,9 +57,9 @@ inline nlohmann::json working_mesh_json(const SurfaceLayout& s) {
 }
 
 //! Loads the layout of a command for \p input (load_layout_on_surface), announcing it.
-inline SurfaceLayout load_command_layout(const std::string& path, const TriMesh& input) {
+inline SurfaceLayout load_command_layout(const std::string& path, TriMesh input) {
   set_activity("loading the layout '" + path + "'");
-  return load_layout_on_surface(path, input);
+  return load_layout_on_surface(path, std::move(input));
 }
 
 inline nlohmann::json layout_json(const LayoutTopology& topo) {

@@ -11,9 +11,6 @@
 
 namespace qs::app {
 
-namespace {
-
-// An edited arc no longer matches anything the optimizer traced for it.
 void clear_arc_outputs(LayoutArc& arc) {
   arc.label.clear();
   arc.polyline.clear();
@@ -26,6 +23,8 @@ void clear_node_outputs(LayoutNode& node) {
   node.position.reset();
   node.valence = -1;
 }
+
+namespace {
 
 bool valid_vertex(const TriMesh& mesh, int v) {
   return v >= 0 && v < int(mesh.n_vertices());

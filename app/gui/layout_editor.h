@@ -54,6 +54,13 @@ int nearest_boundary_vertex(const TriMesh& mesh, const Vec3& point,
 //! 3D position of a surface point (\pre valid face index and barycentrics).
 Vec3 surface_position(const TriMesh& mesh, const SurfacePoint& p);
 
+//! Drops what the optimizer wrote for an arc (label, polyline, samples) and its input `points`:
+//! an edited arc no longer matches them.
+void clear_arc_outputs(LayoutArc& arc);
+//! Drops a moved node's `point`, position and valence (a stale point would snap the node back
+//! when the file is reloaded).
+void clear_node_outputs(LayoutNode& node);
+
 class LayoutEditor {
  public:
   //! Starts editing \p layout on \p mesh (which must outlive the editor's use); clears the

@@ -25,19 +25,6 @@ int node_vertex(const Layout& layout, int id) {
   return k < 0 ? -1 : layout.nodes[k].vertex;
 }
 
-void clear_arc_outputs(LayoutArc& arc) {
-  arc.label.clear();
-  arc.polyline.clear();
-  arc.samples.clear();
-  arc.points.clear();
-}
-
-void clear_node_outputs(LayoutNode& node) {
-  node.point.reset();
-  node.position.reset();
-  node.valence = -1;
-}
-
 // Largest distance from the reflection of a vertex of \p a to the nearest vertex of \p b.
 double path_deviation(const TriMesh& mesh, const Mirror& m, const std::vector<int>& a,
                       const std::vector<int>& b) {

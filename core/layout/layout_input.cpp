@@ -1,6 +1,7 @@
 #include "core/layout/layout_input.h"
 
 #include <memory>
+#include <utility>
 
 #include "core/base/errors.h"
 #include "core/layout/layout_io.h"
@@ -19,15 +20,16 @@ bool layout_needs_working_mesh(const Layout& layout) {
   return false;
 }
 
-SurfaceLayout load_layout_on_surface(const std::string& path, const TriMesh& input,
+SurfaceLayout load_layout_on_surface(const std::string& path, TriMesh input,
                                      const EmbedOptions& options) {
   SurfaceLayout out;
   out.input_vertices = static_cast<int>(input.n_vertices());
   out.input_faces = static_cast<int>(input.n_faces());
   Layout layout = read_layout_file(path);
   if (!layout_needs_working_mesh(layout)) {
-    out.mesh = input;
-    out.layout = load_layout(path, input);
+    resolve_layout(path, layout, input);
+    out.mesh = std::move(input);
+    out.layout = std::move(layout);
     return out;
   }
   check_layout_on_mesh(path, layout, input, /*snap_points=*/false);
@@ -36,7 +38,7 @@ SurfaceLayout load_layout_on_surface(const std::string& path, const TriMesh& inp
     if (node.vertex >= 0) node.point.reset();
   EmbeddedLayout embedded;
   try {
-    embedded = embed_layout(std::make_shared<const TriMesh>(input), layout, options);
+    embedded = embed_layout(std::make_shared<const TriMesh>(std::move(input)), layout, options);
   } catch (const InvalidInputError& e) {
     throw InvalidInputError(path + ": " + e.what());
   }

@@ -28,8 +28,9 @@ struct SurfaceLayout {
 //! `path`.
 bool layout_needs_working_mesh(const Layout& layout);
 
-//! Reads the layout file \p path for \p input. When layout_needs_working_mesh is false, the
-//! result is load_layout's on \p input (points snapped to vertices, arcs routed). Otherwise the
+//! Reads the layout file \p path (once) for \p input, which it takes over (the result's mesh).
+//! When layout_needs_working_mesh is false, the layout is resolved on \p input as load_layout
+//! does (points snapped to vertices, arcs routed). Otherwise the
 //! layout is checked on \p input (check_layout_on_mesh, no snapping) and discretized onto a new
 //! working mesh (embed_layout with \p options): the result's mesh is the working mesh, its nodes
 //! are working-mesh vertices (their `point`s dropped: the vertex is at the point, or within the
@@ -37,7 +38,7 @@ bool layout_needs_working_mesh(const Layout& layout);
 //! \throw InvalidInputError (message starts with \p path) for an unreadable or malformed file,
 //! references outside \p input, or a layout that cannot be embedded (listing the nodes and
 //! arcs involved).
-SurfaceLayout load_layout_on_surface(const std::string& path, const TriMesh& input,
+SurfaceLayout load_layout_on_surface(const std::string& path, TriMesh input,
                                      const EmbedOptions& options = {});
 
 }  // namespace qs

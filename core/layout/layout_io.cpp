@@ -590,14 +590,18 @@ Layout read_layout_file(const std::string& path) {
   return parse_layout_json(read_input_file(path, kMaxLayoutFileBytes), path);
 }
 
-Layout load_layout(const std::string& path, const TriMesh& mesh) {
-  Layout layout = read_layout_file(path);
+void resolve_layout(const std::string& path, Layout& layout, const TriMesh& mesh) {
   check_layout_on_mesh(path, layout, mesh, /*snap_points=*/true);
   try {
     route_layout(mesh, layout);
   } catch (const InvalidInputError& e) {
     throw InvalidInputError(path + ": " + e.what());
   }
+}
+
+Layout load_layout(const std::string& path, const TriMesh& mesh) {
+  Layout layout = read_layout_file(path);
+  resolve_layout(path, layout, mesh);
   return layout;
 }
 

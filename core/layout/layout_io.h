@@ -47,6 +47,10 @@ Layout read_layout_file(const std::string& path);
 void check_layout_on_mesh(const std::string& path, Layout& layout, const TriMesh& mesh,
                           bool snap_points);
 
+//! What load_layout does after reading: check_layout_on_mesh with snapping, then route_layout,
+//! on \p layout read from \p path (named in errors). \throw InvalidInputError as load_layout.
+void resolve_layout(const std::string& path, Layout& layout, const TriMesh& mesh);
+
 //! Reads a layout file and resolves it on \p mesh: checks the optional "mesh" block (vertex
 //! and face counts must match), node vertices (in range), every surface point (node points,
 //! arc points and samples: face in range, finite barycentrics >= -1e-9 summing to 1 within
