@@ -6,11 +6,14 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "app/gui/history.h"
 #include "app/gui/pipeline_job.h"
 #include "core/layout/layout_io.h"
 #include "core/layout/perturb.h"
+#include "core/mesh/mesh_io.h"
 #include "core/nodeopt/optimizer.h"
 #include "core/pipeline/pipeline.h"
 #include "tests/fixtures.h"
@@ -179,51 +182,57 @@ TEST(GuiJob, WrapFreeHolesReachesTheField) {
   EXPECT_GT(wrapped->metrics.foldovers, 0);
 }
 
-// A Run that ends with fold-overs says so and offers what `quadsketch-cli optimize` retries
-// with by itself: keeping the nodes apart and the sizing field, each only while it is off. The
-// case: the flat square whose free hole the field wraps ("Wrap free holes"), which folds
-// wherever the nodes go, unless the untangling runs (it unfolds it at E ≈ 358, and the retries
-// are offered too: the rules of core/nodeopt/retry.h); then without the untangling.
-TEST(GuiJob, RunEndingWithFoldOversOffersTheRetries) {
+// Two states have the same mesh positions and node vertices.
+void expect_same_state(const TriMesh& a, const Layout& la, const TriMesh& b, const Layout& lb) {
+  ASSERT_EQ(a.n_vertices(), b.n_vertices());
+  int moved_differently = 0;
+  for (auto v : a.vertices()) moved_differently += a.point(v) != b.point(v);
+  EXPECT_EQ(moved_differently, 0);
+  ASSERT_EQ(la.nodes.size(), lb.nodes.size());
+  for (size_t n = 0; n < la.nodes.size(); ++n)
+    EXPECT_EQ(la.nodes[n].vertex, lb.nodes[n].vertex) << "node " << n;
+}
+
+// The editor's final state and the engine's result are the same, with the same E.
+void expect_same_result(const Snapshot& editor, const OptimizeResult& engine) {
+  const Pipeline& p = *engine.pipeline;
+  ASSERT_TRUE(editor.exports);
+  expect_same_state(editor.exports->mesh, editor.exports->layout, p.mesh(), p.layout());
+  const Parameterization& param = *p.parameterization();
+  EXPECT_NEAR(editor.energy, param.energy, 1e-9 * std::max(1.0, param.energy));
+  EXPECT_EQ(editor.metrics.foldovers, param.foldovers);
+}
+
+// A Run whose fold-over removal fails retries by itself as `quadsketch-cli optimize` does (keep
+// nodes apart, then the sizing field, while they are left on Auto) and ends where the engine's
+// one-call optimize() ends. The case: the flat square whose free hole the field wraps ("Wrap
+// free holes"), which folds wherever the nodes go when the untangling is off, so both retries
+// run; an explicit choice (On or Off) runs no retry for that setting.
+TEST(GuiJob, RunRetriesAsTheCommandLineDoes) {
   const test::MeshAndLayout sq = test::flat_square_with_free_hole();
   const Example ex{std::make_shared<const TriMesh>(sq.mesh), sq.layout};
   WorkerOptions options;
+  options.publish_interval_ms = 0;
   options.align = false;
   options.wrap_free_holes = true;
-  {
-    const auto untangled = test::run_job(ex, options);
-    ASSERT_EQ(untangled->status, WorkerStatus::Finished) << untangled->message;
-    EXPECT_EQ(untangled->metrics.foldovers, 0) << untangled->message;
-    // The orientation constraints failed, the untangling removed the fold-overs: the retries
-    // that may embed the layout without it are offered (as the command line makes them).
-    EXPECT_NE(untangled->message.find("only the untangling removed the fold-overs: turn on "
-                                      "'Keep nodes apart' or 'Sizing field' and Run again"),
-              std::string::npos)
-        << untangled->message;
-  }
   options.untangle = false;
-  ASSERT_TRUE(options.node_optimization);
-  ASSERT_FALSE(options.sizing);
-  ASSERT_FALSE(options.keep_nodes_apart);
-  const auto plain = test::run_job(ex, options);
-  ASSERT_EQ(plain->status, WorkerStatus::Finished) << plain->message;
-  ASSERT_GT(plain->metrics.foldovers, 0) << "the case must fold: " << plain->message;
-  std::printf("[stat] %s\n", plain->message.c_str());
-  EXPECT_NE(plain->message.find("fold-over(s) remain: turn on 'Keep nodes apart' or 'Sizing "
-                                "field' and Run again"),
-            std::string::npos)
-      << plain->message;
-  options.sizing = true;
-  const auto sized = test::run_job(ex, options);
-  ASSERT_EQ(sized->status, WorkerStatus::Finished) << sized->message;
-  ASSERT_GT(sized->metrics.foldovers, 0) << sized->message;
-  EXPECT_NE(sized->message.find("turn on 'Keep nodes apart' and Run again"), std::string::npos)
-      << sized->message;
-  EXPECT_EQ(sized->message.find("'Sizing field'"), std::string::npos) << sized->message;
-  options.keep_nodes_apart = true;
-  const auto both = test::run_job(ex, options);
-  ASSERT_EQ(both->status, WorkerStatus::Finished) << both->message;
-  EXPECT_EQ(both->message.find("turn on"), std::string::npos) << both->message;
+  ASSERT_FALSE(options.sizing.has_value());
+  ASSERT_FALSE(options.keep_nodes_apart.has_value());
+  const auto editor = test::run_job(ex, options);
+  ASSERT_EQ(editor->status, WorkerStatus::Finished) << editor->message;
+  const OptimizeResult engine = optimize(sq.mesh, sq.layout, optimize_settings(options));
+  ASSERT_TRUE(engine.nodes);
+  ASSERT_GT(engine.nodes->foldovers_final, 0) << "the case must fold";
+  ASSERT_TRUE(engine.keep_apart_retry) << "the case must need the keep-apart retry";
+  ASSERT_TRUE(engine.sizing_retry) << "the case must need the sizing retry";
+  expect_same_result(*editor, engine);
+  EXPECT_NE(editor->message.find("optimizing again from the input"), std::string::npos)
+      << editor->message;
+  options.sizing = false;
+  options.keep_nodes_apart = false;
+  const OptimizeResult decided = optimize(sq.mesh, sq.layout, optimize_settings(options));
+  EXPECT_FALSE(decided.keep_apart_retry);
+  EXPECT_FALSE(decided.sizing_retry);
 }
 
 // "Separate crowded nodes" (WorkerOptions::separate_nodes) reaches the node optimization: on a
@@ -277,9 +286,9 @@ TEST(GuiJob, SizingFieldReachesTheParameterization) {
   EXPECT_EQ(sized->metrics.foldovers, 0);
 }
 
-// A run with the default settings ends where `quadsketch-cli optimize` ends (without
-// stiffening, which the editor leaves out): the same units (descent steps, hop sweeps,
-// fold-over removal), so the same final mesh and node vertices, below the descent alone.
+// A run with the default settings ends where the engine of `quadsketch-cli optimize` ends:
+// the same units (descent steps, hop sweeps, fold-over removal, retries), so the same final mesh
+// and node vertices, below the descent alone.
 TEST(GuiJob, RunEndsWhereTheOptimizerEnds) {
   const Example ex = example();
   WorkerOptions options;
@@ -289,34 +298,49 @@ TEST(GuiJob, RunEndsWhereTheOptimizerEnds) {
   ASSERT_TRUE(s->exports);
   ASSERT_LT(s->iteration, options.max_steps);  // ended by itself
   EXPECT_EQ(int(s->node_history.size()), s->iteration);
+  const OptimizeResult r = optimize(*ex.mesh, ex.layout, optimize_settings(options));
+  ASSERT_TRUE(r.nodes);
+  ASSERT_GT(r.nodes->hop_rounds, 0);
+  expect_same_result(*s, r);
 
-  qs::PipelineOptions po;  // as the job sets them from WorkerOptions
-  po.field.constraints.curvature = options.align;
-  po.field.constraints.sharp_angle_deg = options.sharp_angle_deg;
-  po.param.anisotropy = options.anisotropy;
-  NodeOptOptions no;
-  no.max_steps = options.descent_steps;
-  no.alpha = options.alpha;
-  no.stiffen_at_end = false;
-  const NodeOptResult r = optimize_nodes(*ex.mesh, ex.layout, po, no);
-  ASSERT_GT(r.hop_rounds, 0);
-  const TriMesh& m = s->exports->mesh;
-  ASSERT_EQ(m.n_vertices(), r.mesh.n_vertices());
-  int moved_differently = 0;
-  for (auto v : m.vertices()) moved_differently += m.point(v) != r.mesh.point(v);
-  EXPECT_EQ(moved_differently, 0);
-  ASSERT_EQ(s->exports->layout.nodes.size(), r.layout.nodes.size());
-  for (size_t n = 0; n < r.layout.nodes.size(); ++n)
-    EXPECT_EQ(s->exports->layout.nodes[n].vertex, r.layout.nodes[n].vertex) << "node " << n;
-  EXPECT_NEAR(s->metrics.E, r.E_final, 1e-9 * r.E_final);
-  EXPECT_EQ(s->metrics.foldovers, r.foldovers_final);
-
-  NodeOptOptions descent = no;
-  descent.hop_polish = false;
-  const NodeOptResult d = optimize_nodes(*ex.mesh, ex.layout, po, descent);
+  OptimizeSettings descent = optimize_settings(options);
+  NodeOptOptions no = node_options(descent);
+  no.hop_polish = false;
+  const NodeOptResult d = optimize_nodes(*ex.mesh, ex.layout, pipeline_options(descent), no);
   std::printf("[stat] editor run: %d steps, E %.6g (descent alone %.6g)\n", s->iteration,
               s->metrics.E, d.E_final);
   EXPECT_LT(s->metrics.E, d.E_final * 0.99);
+}
+
+// The editor's Run and `quadsketch-cli optimize` are one engine: on the bundled example with
+// the default settings both write the same node vertices, mesh positions and E.
+TEST(GuiJob, EditorRunEqualsTheCommandLine) {
+  const Example ex = example();
+  WorkerOptions options;
+  options.publish_interval_ms = 0;
+  const auto editor = test::run_job(ex, options);
+  ASSERT_EQ(editor->status, WorkerStatus::Finished) << editor->message;
+  ASSERT_TRUE(editor->exports);
+
+  const std::string dir = test::temp_dir("editor_equals_cli");
+  const fs::path assets = fs::path(QS_ASSETS_DIR) / "example";
+  std::string log;
+  ASSERT_EQ(test::run_command(test::cli_path() + " optimize --quiet --mesh " +
+                                  (assets / "ellipsoid.obj").string() + " --layout " +
+                                  (assets / "ellipsoid.layout.json").string() + " --out " + dir,
+                              &log),
+            0)
+      << log;
+  const TriMesh cli_mesh = load_mesh(dir + "/param.obj");
+  const Layout cli_layout = load_layout(dir + "/layout.json", cli_mesh);
+  // param.obj stores positions with 17 digits: exactly.
+  expect_same_state(cli_mesh, cli_layout, editor->exports->mesh, editor->exports->layout);
+  std::ifstream report_file(dir + "/report.json");
+  const nlohmann::json report = nlohmann::json::parse(report_file);
+  EXPECT_NEAR(report["E_final"].get<double>(), editor->metrics.E,
+              1e-9 * std::max(1.0, editor->metrics.E));
+  EXPECT_EQ(report["metrics"]["foldovers"].get<int>(), editor->metrics.foldovers);
+  fs::remove_all(dir);
 }
 
 // A node pinned between steps keeps its position for the rest of the run (the fold-over

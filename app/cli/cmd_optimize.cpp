@@ -15,13 +15,12 @@
 #include "app/cli/report.h"
 #include "app/cli/signals.h"
 #include "core/base/solver_threads.h"
+#include "core/engine/optimize.h"
 #include "core/extract/quads.h"
 #include "core/layout/layout_io.h"
 #include "core/mesh/mesh_io.h"
-#include "core/nodeopt/discrete.h"
 #include "core/nodeopt/gradient.h"
 #include "core/nodeopt/optimizer.h"
-#include "core/nodeopt/retry.h"
 #include "core/pipeline/integer_sizes.h"
 #include "core/pipeline/pipeline.h"
 
@@ -93,6 +92,48 @@ void require_quad_count_within_limit(double quads, double quad_size, const std::
 }
 
 // Total area of the mesh's faces (length²).
+// The report's account of one retry of the node optimization.
+nlohmann::json retry_json(const RetryRecord& r) {
+  return {{"foldovers_without", r.foldovers_without},
+          {"E_final_without", r.E_without},
+          {"foldovers_with", r.foldovers_with},
+          {"E_final_with", r.E_with},
+          {"untangled_without", r.untangled_without},
+          {"untangled_with", r.untangled_with},
+          {"used", r.used},
+          {"time_s", r.time_s}};
+}
+
+// The engine settings that the flags of `optimize` mean.
+OptimizeSettings optimize_settings(const OptimizeOptions& o) {
+  OptimizeSettings s;
+  s.field.align = !o.no_align;
+  s.field.sharp_angle_deg = o.sharp_angle_deg;
+  s.field.max_cluster_faces = o.max_cluster_faces;
+  s.field.wrap_free_holes = o.wrap_free_holes;
+  s.param.sizing = o.sizing;
+  s.nodes.enabled = !o.no_node_opt;
+  s.nodes.steps = o.steps;
+  s.nodes.method = o.discrete_relocation   ? NodeMethod::kDiscrete
+                   : o.gradient == "exact" ? NodeMethod::kExact
+                                           : NodeMethod::kEstimator;
+  s.nodes.slide_on_curves = !o.no_sliding;
+  s.nodes.keep_sharp_edges = o.keep_sharp_edges;
+  s.nodes.keep_apart = o.keep_nodes_apart;
+  s.nodes.separate_crowded = o.separate_nodes;
+  s.nodes.time_limit_s = o.time_limit_s;
+  if (o.no_orientation) s.folds.remove = false;
+  if (o.orientation) s.folds.remove = true;
+  s.folds.sectors = o.orientation_sectors == "field"      ? SectorFrame::kField
+                    : o.orientation_sectors == "solution" ? SectorFrame::kSolution
+                                                          : SectorFrame::kFieldThenSolution;
+  s.folds.untangle = !o.no_untangle;
+  s.sizes.integer = o.integer;
+  s.sizes.quad_size = o.quad_size;
+  s.sizes.quad_count = o.quad_count;
+  return s;
+}
+
 double surface_area(const TriMesh& mesh) {
   double area = 0;
   for (const auto f : mesh.faces()) area += mesh.calc_face_area(f);
@@ -107,11 +148,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
     namespace fs = std::filesystem;
     const auto t_total = std::chrono::steady_clock::now();
     auto t0 = t_total;
-    MeshReport mesh_report;
-    set_activity("loading the mesh '" + o.mesh + "'");
-    SurfaceLayout on_surface = load_command_layout(o.layout, load_mesh(o.mesh, &mesh_report));
-    report["mesh"] = mesh_json(mesh_report);
-    report["working_mesh"] = working_mesh_json(on_surface);
+    SurfaceLayout on_surface = load_command_inputs(o.mesh, o.layout, report);
     TriMesh mesh = std::move(on_surface.mesh);
     Layout layout = std::move(on_surface.layout);
     // A parameterization close to isometric has about the surface's area: refuse an absurd
@@ -123,12 +160,6 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       require_quad_count_within_limit(area / (o.quad_size * o.quad_size), o.quad_size, basis.str());
     }
     const double load_s = seconds_since(t0);
-    PipelineOptions options;
-    options.field.constraints.sharp_angle_deg = o.sharp_angle_deg;
-    options.field.max_cluster_faces = o.max_cluster_faces;
-    if (o.wrap_free_holes) options.field.free_loops = FreeLoopTurning::kWrap;
-    options.field.constraints.curvature = !o.no_align;
-    if (o.sizing) options.param.sizing.enabled = *o.sizing;
     if (o.integer && !(o.quad_size > 0 || o.quad_count > 0))
       throw InvalidInputError("--integer needs --quad-size Q or --quad-count N");
     if (o.atlas != "per-patch" && !(o.quad_size > 0 || o.quad_count > 0))
@@ -145,229 +176,31 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
           "--discrete-relocation)");
     if (o.orientation && o.no_orientation)
       throw InvalidInputError("--orientation and --no-orientation contradict each other");
-    const SectorFrame sector_frame = o.orientation_sectors == "field" ? SectorFrame::kField
-                                     : o.orientation_sectors == "solution"
-                                         ? SectorFrame::kSolution
-                                         : SectorFrame::kFieldThenSolution;
-    // Node optimization first (it runs its own field + parameterization solves); the final
-    // stages below then run on its result.
-    double node_s = 0;
-    std::optional<NodeOptResult> node_result;
+    // The whole policy (node optimization, retries, integer sizes) is the engine's
+    // (core/engine/optimize.h), the same that the editor's Run drives step by step.
+    const OptimizeSettings settings = optimize_settings(o);
     ProgressPrinter printer(common.quiet);
+    const auto print_notes = [&](OptimizeRun& run) {
+      for (const std::string& note : run.take_notes())
+        if (!common.quiet) std::cerr << "optimize: " << note << "\n";
+    };
+    if (!o.no_node_opt) set_activity("optimizing the nodes");
+    OptimizeRun run(std::move(mesh), std::move(layout), settings, &printer);
+    // The initial solve reports a layout that contradicts the curvature before the long run.
     bool warned_about_constraints = false;
-    // --time-limit: one deadline for every node optimization run (set when the first starts).
-    std::optional<std::chrono::steady_clock::time_point> deadline;
-    const auto time_limit = [&]() -> std::function<bool()> {
-      if (o.time_limit_s <= 0) return {};
-      if (!deadline)
-        deadline = std::chrono::steady_clock::now() +
-                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                       std::chrono::duration<double>(o.time_limit_s));
-      const auto end = *deadline;
-      return [end] { return std::chrono::steady_clock::now() >= end; };
-    };
-    // NodeOptOptions::keep_nodes_apart of the run that is written (the retry below may set it).
-    bool keep_apart = o.keep_nodes_apart.value_or(false);
-    const auto optimize = [&](const TriMesh& start_mesh, const Layout& start_layout,
-                              const PipelineOptions& run_options, bool apart) {
-      if (o.discrete_relocation) {
-        DiscreteOptions d;
-        d.max_steps = o.steps;
-        d.stop = time_limit();
-        return relocate_nodes_discrete(start_mesh, start_layout, run_options, d, &printer);
-      }
-      NodeOptOptions no;
-      no.max_steps = o.steps;
-      no.stop = time_limit();
-      no.gradient = o.gradient == "exact" ? GradientMethod::Exact : GradientMethod::Estimator;
-      no.orientation_at_end = !o.no_orientation;
-      no.orientation.sector_frame = sector_frame;
-      no.orientation.untangle = !o.no_untangle;
-      no.slide_on_curves = !o.no_sliding;
-      no.sharp_edges_as_curves = o.keep_sharp_edges;
-      no.keep_nodes_apart = apart;
-      no.separate_crowded_nodes = o.separate_nodes;
-      // Integer sizes put nodes exactly on shared iso-lines: fresh trial Pipelines there (see
-      // NodeOptOptions::reuse_field).
-      if (o.integer) no.reuse_field = false;
-      // The optimizer's initial solve (of the layout it starts from, after --separate-nodes)
-      // reports a layout that contradicts the curvature before the long run rather than after.
-      NodeOptimizer optimizer(start_mesh, start_layout, run_options, no, &printer);
-      if (!warned_about_constraints)
-        warned_about_constraints = warn_about_released_constraints(
-            *optimizer.pipeline(&printer)->field(), "optimize (initial field)");
-      while (optimizer.step(&printer)) {
-      }
-      NodeOptResult result = optimizer.finish(&printer);
-      if (!common.quiet && result.crowded_nodes > 0)
-        std::cerr << "optimize: " << result.separated_nodes.size() << " of " << result.crowded_nodes
-                  << " crowded node(s) moved apart before the node optimization\n";
-      return result;
-    };
-    // After a run: its mesh, layout and the options of its final solve.
-    const auto adopt = [&](NodeOptResult result) {
-      mesh = result.mesh;
-      layout = result.layout;
-      options.param.face_weights = result.face_weights;
-      if (result.orientation_constraints)  // the final solve is the constrained one
-        options.param.orientation = result.orientation_options;
-      node_result = std::move(result);
-    };
-    // --no-node-opt --orientation: the final solve checks for fold-overs and, when there are
-    // any, solves the orientation-constrained QP (ParamSolver::solve), cancellable by signal.
-    if (o.orientation) {
-      options.param.orientation.enabled = true;
-      options.param.orientation.sector_frame = sector_frame;
-      options.param.orientation.untangle = !o.no_untangle;
-      options.param.orientation.observer = &printer;
-    }
-    // Node optimization, then the retries below when it fails.
-    nlohmann::json sizing_retry, apart_retry;
-    if (!o.no_node_opt) {
-      t0 = std::chrono::steady_clock::now();
-      set_activity("optimizing the nodes");
-      const bool may_retry_apart =
-          !o.keep_nodes_apart && !o.discrete_relocation && !o.no_orientation;
-      const bool may_retry =
-          !o.sizing && !o.discrete_relocation && !o.no_orientation && !options.param.sizing.enabled;
-      std::optional<TriMesh> input_mesh;
-      std::optional<Layout> input_layout;
-      if (may_retry || may_retry_apart) input_mesh = mesh, input_layout = layout;
-      const PipelineOptions input_options = options;
-      adopt(optimize(mesh, layout, options, keep_apart));
-      // One retry from the input with \p run_options and \p apart (\p with names it, \p flags
-      // the options that decide it up front). The retry's run is adopted when \p better(retry,
-      // first) says so (`used` in the report entry, to which the caller adds its own fields).
-      struct Retry {
-        nlohmann::json entry;
-        bool used = false;
-        NodeOptResult run;
-      };
-      const auto retry = [&](const std::string& with, const std::string& flags,
-                             const PipelineOptions& run_options, bool apart, auto better) {
-        const NodeOptResult& first = *node_result;
-        if (!common.quiet) {
-          std::cerr << "optimize: ";
-          if (first.foldovers_final > 0)
-            std::cerr << first.foldovers_final << " fold-over(s) remain";
-          else if (first.untangled)
-            std::cerr << "only the untangling removed the fold-overs";
-          else if (first.initial_reverted)
-            std::cerr << "the fold-over removal fell back to the initial state";
-          else
-            std::cerr << "the fold-over removal fell back to an earlier state";
-          std::cerr << "; optimizing again from the input with " << with << " (" << flags
-                    << " decides this up front)\n";
-        }
-        const auto t_retry = std::chrono::steady_clock::now();
-        NodeOptResult second = optimize(*input_mesh, *input_layout, run_options, apart);
-        const bool used = better(second, first);
-        nlohmann::json entry = {{"foldovers_without", first.foldovers_final},
-                                {"E_final_without", first.E_final},
-                                {"foldovers_with", second.foldovers_final},
-                                {"E_final_with", second.E_final},
-                                {"untangled_without", first.untangled},
-                                {"untangled_with", second.untangled},
-                                {"used", used}};
-        if (!common.quiet)
-          std::cerr << "optimize: with " << with << " " << second.foldovers_final
-                    << " fold-over(s) remain at E " << second.E_final << " ("
-                    << first.foldovers_final << " at E " << first.E_final
-                    << " without): " << (used ? "using it" : "keeping the run without it") << "\n";
-        entry["time_s"] = seconds_since(t_retry);
-        return Retry{std::move(entry), used, std::move(second)};
-      };
-      // The keep-apart retry comes first: when the user left --keep-nodes-apart to the default
-      // (off) and the fold-over removal leaves fold-overs or has to fall back to the accepted
-      // state with the fewest fold-overs or to the initial state (the descent went where no
-      // orientation-constrained solve embeds the layout), the input is optimized again with
-      // NodeOptOptions::keep_nodes_apart, and that run is taken when it ends with fewer fold-overs,
-      // or as many at a lower E. Nodes crowding onto one triangle are what made the exact pig's
-      // optimized layouts fail (the default fell back to the initial state;
-      // kept apart, the optimized layout embedded). Not the default itself:
-      // crowded starts (the displaced spot) then keep fold-overs the default removes.
-      // The rules: core/nodeopt/retry.h.
-      if (may_retry_apart && wants_keep_apart_retry(*node_result)) {
-        const bool fell_back_without = fell_back(*node_result);
-        Retry r = retry("nodes kept apart", "--keep-nodes-apart or --no-keep-nodes-apart",
-                        input_options, true, keep_apart_retry_is_better);
-        apart_retry = std::move(r.entry);
-        apart_retry["fell_back_without"] = fell_back_without;
-        if (r.used) {
-          keep_apart = true;
-          adopt(std::move(r.run));
-        }
-      }
-      // The sizing retry: when the user left the sizing field to the default (off) and
-      // fold-overs remain after the node optimization's fold-over removal, or it embedded only
-      // the initial state (the node movement given up), the layout is optimized again from the
-      // input with the sizing field (and the keep-apart choice made above), and that run is
-      // taken when it ends with fewer fold-overs, or as many without falling back to the initial
-      // state (the rocker-arm cage layout with the field frame's sectors and the exact cow
-      // embed only with it). E is no
-      // criterion here: the sizing field changes the energy. An explicit --sizing or
-      // --no-sizing decides up front; --no-orientation (stiffening only, an ablation) and the
-      // discrete baseline are run as asked.
-      if (may_retry && wants_sizing_retry(*node_result)) {
-        PipelineOptions sized = input_options;
-        sized.param.sizing.enabled = true;
-        const bool initial_without = node_result->initial_reverted;
-        Retry r = retry("the sizing field", "--sizing or --no-sizing", sized, keep_apart,
-                        sizing_retry_is_better);
-        sizing_retry = std::move(r.entry);
-        sizing_retry["initial_without"] = initial_without;
-        sizing_retry["initial_with"] = r.run.initial_reverted;
-        if (r.used) {
-          options = sized;
-          adopt(std::move(r.run));
-        }
-      }
-      node_s = seconds_since(t0);
-    }
-    // --integer (paper §8): round every arc's length on the relaxed result to a multiple of Q
-    // (one value per poly-chord), then optimize again with those lengths as constraints.
-    std::optional<IntegerSizes> integer;
-    double E_relaxed = 0;
-    std::optional<NodeOptResult> relaxed_result;
-    if (o.integer) {
-      std::shared_ptr<Pipeline> relaxed;
-      if (node_result && node_result->pipeline && node_result->face_weights.empty())
-        relaxed = node_result->pipeline;
-      else
-        relaxed = std::make_shared<Pipeline>(mesh, layout, options);
-      if (!relaxed->parameterization()) relaxed->compute_parameterization();
-      E_relaxed = unweighted_energy(relaxed->mesh(), relaxed->geometry(), relaxed->field()->theta,
-                                    *relaxed->parameterization(), options.param);
-      const double q = o.quad_size > 0 ? o.quad_size
-                                       : quad_size_for_count(relaxed->topology(),
-                                                             relaxed->extract(), o.quad_count);
-      integer = round_arc_lengths(relaxed->param_solver()->arc_lengths(), q);
-      if (!common.quiet)
-        std::cerr << "optimize: integer sizes with quad size " << q << ": "
-                  << integer->lengths.size() << " arc lengths rounded (largest change "
-                  << integer->max_change << "), relaxed E = " << E_relaxed << "\n";
-      PipelineOptions fixed = options;
-      fixed.param.arc_lengths = integer->lengths;
-      fixed.param.face_weights.clear();
-      // The node optimizer's constrained solve is not carried over; --no-node-opt --orientation
-      // keeps its own (set above: no node optimization has replaced it).
-      if (!o.orientation) fixed.param.orientation = PipelineOptions{}.param.orientation;
-      options = fixed;
-      if (!o.no_node_opt) {
-        t0 = std::chrono::steady_clock::now();
-        relaxed_result = std::move(node_result);
-        node_result.reset();
-        adopt(optimize(mesh, layout, options, keep_apart));
-        node_s += seconds_since(t0);
-      }
-    }
-    // The optimizer hands back its final Pipeline (solved with `options`, orientation
-    // constraints included when they were used); only stiffening weights need a new solve.
-    std::shared_ptr<Pipeline> solved;
-    if (node_result && node_result->pipeline && node_result->face_weights.empty())
-      solved = node_result->pipeline;
-    else
-      solved = std::make_shared<Pipeline>(std::move(mesh), std::move(layout), options);
+    if (!o.no_node_opt && !o.discrete_relocation)
+      warned_about_constraints = warn_about_released_constraints(*run.pipeline(&printer)->field(),
+                                                                 "optimize (initial field)");
+    while (run.step(&printer)) print_notes(run);
+    OptimizeResult result = run.finish(&printer);
+    print_notes(run);
+    const PipelineOptions& options = result.options;
+    const std::optional<NodeOptResult>& node_result = result.nodes;
+    const std::optional<NodeOptResult>& relaxed_result = result.relaxed;
+    const std::optional<IntegerSizes>& integer = result.integer;
+    const double E_relaxed = result.E_relaxed;
+    const double node_s = result.node_time_s;
+    std::shared_ptr<Pipeline> solved = result.pipeline;
     Pipeline& pipeline = *solved;
     set_activity("computing the final field, parameterization and extraction");
     report["layout"] = layout_json(pipeline.topology());
@@ -403,7 +236,7 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
                                    {"phase", r.phase},
                                    {"moved_nodes", r.moved_nodes}});
       }
-      const bool time_limited = node_result->stopped || (relaxed_result && relaxed_result->stopped);
+      const bool time_limited = result.time_limited;
       if (time_limited && !common.quiet)
         std::cerr << "optimize: the time limit (" << o.time_limit_s
                   << " s) ended the node movement after " << node_result->steps
@@ -431,11 +264,20 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
           {"initial_reverted", node_result->initial_reverted},
           {"untangled", node_result->untangled},
           {"fold_free_reverted", node_result->fold_free_reverted},
-          {"keep_nodes_apart", keep_apart},
+          {"keep_nodes_apart", result.keep_nodes_apart},
           {"crowded_nodes", node_result->crowded_nodes},
           {"separated_nodes", node_result->separated_nodes}};
-      if (!apart_retry.is_null()) report["node_optimization"]["keep_apart_retry"] = apart_retry;
-      if (!sizing_retry.is_null()) report["node_optimization"]["sizing_retry"] = sizing_retry;
+      if (result.keep_apart_retry) {
+        nlohmann::json& j = report["node_optimization"]["keep_apart_retry"];
+        j = retry_json(*result.keep_apart_retry);
+        j["fell_back_without"] = result.keep_apart_retry->fell_back_without;
+      }
+      if (result.sizing_retry) {
+        nlohmann::json& j = report["node_optimization"]["sizing_retry"];
+        j = retry_json(*result.sizing_retry);
+        j["initial_without"] = result.sizing_retry->initial_without;
+        j["initial_with"] = result.sizing_retry->initial_with;
+      }
       warn_about_infeasible_orientation(node_result->orientation, param.foldovers, pipeline.mesh(),
                                         pipeline.layout());
     }

@@ -77,11 +77,7 @@ int run_field(const FieldOptions& o, const CommonOptions& common) {
   return with_report(o.out, [&](nlohmann::json& report) {
     const auto t_total = std::chrono::steady_clock::now();
     auto t0 = t_total;
-    MeshReport mesh_report;
-    set_activity("loading the mesh '" + o.mesh + "'");
-    SurfaceLayout on_surface = load_command_layout(o.layout, load_mesh(o.mesh, &mesh_report));
-    report["mesh"] = mesh_json(mesh_report);
-    report["working_mesh"] = working_mesh_json(on_surface);
+    SurfaceLayout on_surface = load_command_inputs(o.mesh, o.layout, report);
     TriMesh mesh = std::move(on_surface.mesh);
     Layout layout = std::move(on_surface.layout);
     const double load_s = seconds_since(t0);

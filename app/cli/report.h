@@ -62,6 +62,18 @@ inline SurfaceLayout load_command_layout(const std::string& path, TriMesh input)
   return load_layout_on_surface(path, std::move(input));
 }
 
+//! Loads the mesh and the layout of a command (load_mesh, then load_command_layout), announcing
+//! each, and records their "mesh" and "working_mesh" blocks in \p report.
+inline SurfaceLayout load_command_inputs(const std::string& mesh_path,
+                                         const std::string& layout_path, nlohmann::json& report) {
+  MeshReport mesh_report;
+  set_activity("loading the mesh '" + mesh_path + "'");
+  SurfaceLayout on_surface = load_command_layout(layout_path, load_mesh(mesh_path, &mesh_report));
+  report["mesh"] = mesh_json(mesh_report);
+  report["working_mesh"] = working_mesh_json(on_surface);
+  return on_surface;
+}
+
 inline nlohmann::json layout_json(const LayoutTopology& topo) {
   int irregular = 0;
   for (int v : topo.valence) irregular += (v != 4);

@@ -1,11 +1,25 @@
 // Pipeline options (collapsed by default): the settings of the next Run / Step, as the
 // command line's `quadsketch-cli optimize` flags.
 #include <algorithm>
+#include <optional>
 
 #include "app/gui/panels.h"
 #include "app/gui/ui_text.h"
 
 namespace qs::app {
+
+namespace {
+
+// A setting that is on, off, or left to the run ("Auto": off, retried with it when the
+// fold-over removal fails, as the command line does without the flag).
+void tri_state(const char* label, std::optional<bool>& value) {
+  const char* names[] = {"Auto", "On", "Off"};
+  int index = !value ? 0 : *value ? 1 : 2;
+  if (ImGui::Combo(label, &index, names, 3))
+    value = index == 0 ? std::nullopt : std::optional<bool>(index == 1);
+}
+
+}  // namespace
 
 void draw_pipeline_options(AppContext& ctx) {
   // Collapsed by default: the defaults suit most layouts.
@@ -40,12 +54,13 @@ void draw_pipeline_options(AppContext& ctx) {
                          ImGuiSliderFlags_Logarithmic))
     o.anisotropy = anisotropy;
   tooltip("How much more misalignment costs than scale in energy (1) (1: isotropic)");
-  ImGui::Checkbox("Sizing field", &o.sizing);
+  tri_state("Sizing field", o.sizing);
   tooltip(
       "Scale the targets by the curl-reducing sizing field (paper \xc2\xa7"
       "5.3): patches may "
       "vary in size, which lowers E (on the paper's models by 6-64 %) and can unfold a "
-      "layout, but the node optimization takes longer and lands in other optima (--sizing)");
+      "layout, but the node optimization takes longer and lands in other optima (--sizing). "
+      "Auto: off, and the run tries again with it when fold-overs remain");
   ImGui::Checkbox("Node optimization", &o.node_optimization);
   if (!o.node_optimization) ImGui::BeginDisabled();
   ImGui::SliderInt("Descent steps", &o.descent_steps, 0, 200, "%d", ImGuiSliderFlags_Logarithmic);
@@ -60,11 +75,12 @@ void draw_pipeline_options(AppContext& ctx) {
   tooltip(
       "Nodes on sharp edges slide along them and no vertex on a sharp edge is moved: sharp "
       "edges keep their shape, at a higher E (--keep-sharp-edges)");
-  ImGui::Checkbox("Keep nodes apart", &o.keep_nodes_apart);
+  tri_state("Keep nodes apart", o.keep_nodes_apart);
   tooltip(
       "No node moves onto a vertex next to another node (no two nodes on one triangle): for "
       "dense layouts with a few edges per patch side, where crowded nodes keep fold-overs "
-      "(--keep-nodes-apart)");
+      "(--keep-nodes-apart). Auto: off, and the run tries again with it when fold-overs remain "
+      "or the fold-over removal falls back");
   ImGui::Checkbox("Untangle fold-overs", &o.untangle);
   tooltip(
       "Where the orientation constraints leave fold-overs, untangle the parameterization: a "

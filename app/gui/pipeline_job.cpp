@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "core/base/errors.h"
+#include "core/engine/optimize.h"
 #include "core/layout/layout.h"
 #include "core/layout/layout_io.h"
 #include "core/nodeopt/optimizer.h"
-#include "core/nodeopt/retry.h"
 #include "core/pipeline/pipeline.h"
 
 namespace qs::app {
@@ -36,20 +36,18 @@ class CancelForwarder : public Observer {
 };
 
 struct JobState {
-  TriMesh mesh;                 // current geometry (node relocation moves vertices on the surface)
-  Layout layout;                // current layout (node vertices, re-routed arcs)
-  PipelineOptions options;      // fixed when the job starts (WorkerOptions of that moment)
-  NodeOptOptions node_options;  // fixed when the job starts
-  std::set<int> pinned_in_layout;       // nodes pinned in the editor's layout
+  TriMesh mesh;                    // the displayed state's geometry (nodes move on the surface)
+  Layout layout;                   // the displayed state's layout (node vertices, re-routed arcs)
+  std::set<int> pinned_in_layout;  // nodes pinned in the editor's layout
   std::set<int> arcs_pinned_in_layout;  // arcs pinned in the editor's layout
   double energy = 0;
   StepMetrics metrics;  // of the last displayed state (repeated for rejected steps)
-  //! Solved (field + parameterization) at exactly (mesh, layout), or null: the display reuses
-  //! it (no re-solve); the initial one is the node optimizer's start.
+  //! Solved (field + parameterization) at exactly (mesh, layout): the display reuses it.
   std::shared_ptr<Pipeline> pipeline;
-  //! The node optimization, created at the first step after the initial solve: the same units
-  //! as `quadsketch-cli optimize` (descent steps, hop sweeps, fold-over removal at the end).
-  std::unique_ptr<NodeOptimizer> optimizer;
+  //! The whole `quadsketch-cli optimize` policy (core/engine/optimize.h): its initial solve at
+  //! the first step, then one unit (descent step, hop sweep, a retry's start) per step.
+  std::unique_ptr<OptimizeRun> run;
+  int runs = 0;  // OptimizeRun::runs() at the last step
 };
 
 // Node positions of \p layout on \p mesh: the traced position when known, else the vertex.
@@ -71,17 +69,28 @@ std::shared_ptr<const NodeFrame> node_frame(const TriMesh& mesh, const Layout& l
   return frame;
 }
 
-PipelineOptions pipeline_options(const WorkerOptions& o) {
-  PipelineOptions options;
-  options.field.constraints.curvature = o.align;
-  options.field.constraints.sharp_angle_deg = o.sharp_angle_deg;
-  options.field.max_cluster_faces = o.max_cluster_faces;
-  if (o.wrap_free_holes) options.field.free_loops = FreeLoopTurning::kWrap;
-  options.param.anisotropy = o.anisotropy;
-  options.param.sizing.enabled = o.sizing;
-  options.param.orientation.untangle = o.untangle;
-  return options;
+}  // namespace
+
+OptimizeSettings optimize_settings(const WorkerOptions& o) {
+  OptimizeSettings s;
+  s.field.align = o.align;
+  s.field.sharp_angle_deg = o.sharp_angle_deg;
+  s.field.max_cluster_faces = o.max_cluster_faces;
+  s.field.wrap_free_holes = o.wrap_free_holes;
+  s.param.anisotropy = o.anisotropy;
+  s.param.sizing = o.sizing;
+  s.nodes.enabled = o.node_optimization;
+  s.nodes.steps = o.descent_steps;
+  s.nodes.alpha = o.alpha;
+  s.nodes.keep_sharp_edges = o.keep_sharp_edges;
+  s.nodes.keep_apart = o.keep_nodes_apart;
+  s.nodes.separate_crowded = o.node_optimization && o.separate_nodes;
+  if (!o.node_optimization) s.folds.remove = o.remove_foldovers;
+  s.folds.untangle = o.untangle;
+  return s;
 }
+
+namespace {
 
 // The solved field for display: first direction per face and the constraints (in force or
 // released).
@@ -121,17 +130,16 @@ std::shared_ptr<const QuadOverlay> overlay_of(const QuadMesh& quads) {
   return overlay;
 }
 
-// Solves field + parameterization (unless job.pipeline already holds them, e.g. handed back by
-// the node optimizer) + extraction for the job's current state and fills the
+// Solves what job.pipeline lacks of field + parameterization (the run hands it over solved) +
+// extraction for the job's current state and fills the
 // parts of a StepResult the UI draws (metrics, timings, node positions, exports; the quad mesh
 // when \p build_quads). Updates state.layout with the traced arcs.
 StepResult solve_for_display(JobState& job, WorkerState& state, const WorkerObserver& observer,
                              bool build_quads) {
   StepResult result;
   StepMetrics& m = result.metrics;
-  // The node optimizer hands back its solved Pipeline: solve only when there is none.
-  if (!job.pipeline || !job.pipeline->parameterization())
-    job.pipeline = std::make_shared<Pipeline>(job.mesh, job.layout, job.options);
+  // The run hands over its solved Pipeline (the fixed-node one may still need its solve).
+  if (!job.pipeline) throw std::logic_error("solve_for_display: no Pipeline");
   Pipeline& pipeline = *job.pipeline;
   observer.check_cancel();
   auto t = Clock::now();
@@ -227,152 +235,101 @@ std::vector<char> arc_pin_flags(const WorkerState& state, const JobState& job,
   return flags;
 }
 
-// The editor's node optimization: `quadsketch-cli optimize` with the job's settings, except that
-// stiffening is left out (the display shows the solve without its face weights).
-NodeOptOptions editor_node_options(const WorkerOptions& o) {
-  NodeOptOptions no;
-  no.max_steps = o.descent_steps;
-  no.alpha = o.alpha;
-  no.sharp_edges_as_curves = o.keep_sharp_edges;
-  no.keep_nodes_apart = o.keep_nodes_apart;
-  no.separate_crowded_nodes = o.separate_nodes;
-  no.orientation.untangle = o.untangle;
-  no.stiffen_at_end = false;
-  return no;
-}
-
 }  // namespace
 
 StepResult pipeline_step(WorkerState& state, const WorkerObserver& observer) {
   const auto start = Clock::now();
   auto job = std::static_pointer_cast<JobState>(state.user);
+  CancelForwarder cancel(observer);
+  std::string prefix;  // what this step did, before the metrics
+  const auto add = [&prefix](const std::string& text) {
+    if (text.empty()) return;
+    prefix += (prefix.empty() ? "" : "; ") + text;
+  };
   if (!job) {
     job = std::make_shared<JobState>();
-    job->mesh = *state.mesh;
-    job->layout = state.layout;
-    job->options = pipeline_options(state.options);
-    job->node_options = editor_node_options(state.options);
-    // Crowded nodes moved apart before the initial solve, so that it shows where the run
-    // starts (and the optimizer starts from that solve).
-    std::string separated;
-    if (job->node_options.separate_crowded_nodes) {
-      job->node_options.separate_crowded_nodes = false;
-      if (auto s = separate_movable_nodes(job->mesh, job->layout)) {
-        if (!s->moved_nodes.empty()) job->layout = std::move(s->layout);
-        if (!s->crowded_nodes.empty())
-          separated = std::to_string(s->moved_nodes.size()) + " of " +
-                      std::to_string(s->crowded_nodes.size()) + " crowded node(s) moved apart; ";
-      }
-    }
-    for (const auto& node : job->layout.nodes)
+    for (const auto& node : state.layout.nodes)
       if (node.pinned) job->pinned_in_layout.insert(node.id);
-    for (const auto& arc : job->layout.arcs)
+    for (const auto& arc : state.layout.arcs)
       if (arc.pinned) job->arcs_pinned_in_layout.insert(arc.id);
+    job->run = std::make_unique<OptimizeRun>(*state.mesh, state.layout,
+                                             optimize_settings(state.options), &cancel);
+    job->runs = job->run->runs();
+    job->mesh = job->run->mesh();
+    job->layout = job->run->layout();
+    job->pipeline = job->run->pipeline(&cancel);
     state.user = job;
-    const bool last = !state.options.node_optimization || state.options.max_steps <= 1;
-    // Fixed nodes with fold-over removal: the solve checks for fold-overs and runs the
-    // orientation-constrained QP when there are any (polling the worker for cancellation).
-    const bool orient = !state.options.node_optimization && state.options.remove_foldovers;
-    // The observer pointer is valid during this call only: cleared on every exit.
-    struct ClearObserver {
-      PipelineOptions& options;
-      ~ClearObserver() { options.param.orientation.observer = nullptr; }
-    } clear_observer{job->options};
-    if (orient) {
-      job->options.param.orientation.enabled = true;
-      job->options.param.orientation.observer = &observer;
-    }
+    const bool fixed = !state.options.node_optimization;
+    const bool last = fixed || state.options.max_steps <= 1;
     StepResult result = solve_for_display(*job, state, observer, last);
     job->metrics = result.metrics;
-    result.finished = !state.options.node_optimization;
-    result.message = "initial solve: " + separated + result.message;
-    if (orient && job->pipeline && job->pipeline->parameterization()) {
-      const OrientationReport& r = job->pipeline->parameterization()->orientation;
-      if (r.ran)
-        result.message += "; fold-overs " + std::to_string(r.foldovers_before) + " -> " +
-                          std::to_string(job->pipeline->parameterization()->foldovers) +
-                          " by orientation constraints" +
-                          (r.success ? "" : " (not used: " + r.message + ")");
+    result.finished = fixed;
+    result.message = "initial solve: " + result.message;
+    const Parameterization* param = job->pipeline->parameterization();
+    if (fixed && param && param->orientation.ran) {
+      const OrientationReport& r = param->orientation;
+      result.message += "; fold-overs " + std::to_string(r.foldovers_before) + " -> " +
+                        std::to_string(param->foldovers) + " by orientation constraints" +
+                        (r.success ? "" : " (not used: " + r.message + ")");
     }
     result.metrics.total_ms = ms_since(start);
     return result;
   }
-  // The next unit of node optimization (a descent step or a hop sweep) from the current state;
-  // the fold-over removal when the optimization ends or the run's last step has come.
-  CancelForwarder cancel(observer);
+  // The next unit of the run from the current state; the end of the run (fold-over removal,
+  // the choice among the runs, the final solve) when it is over or the job's last step came.
+  OptimizeRun& run = *job->run;
   auto t = Clock::now();
-  if (!job->optimizer) {
-    std::shared_ptr<Pipeline> start_pipeline = std::move(job->pipeline);  // solved in place later
-    job->optimizer = std::make_unique<NodeOptimizer>(job->mesh, job->layout, job->options,
-                                                     job->node_options, &cancel, start_pipeline);
-  }
-  NodeOptimizer& optimizer = *job->optimizer;
-  optimizer.set_pinned(pin_flags(state, *job, optimizer.layout()),
-                       arc_pin_flags(state, *job, optimizer.layout()));
-  const size_t reports_before = optimizer.reports().size();
-  const bool more = optimizer.step(&cancel);
+  run.set_pinned(pin_flags(state, *job, run.layout()), arc_pin_flags(state, *job, run.layout()));
+  const size_t reports_before = run.runs() == job->runs ? run.reports().size() : 0;
+  const bool more = run.step(&cancel);
+  const bool restarted = run.runs() != job->runs;  // a retry started from the input
+  job->runs = run.runs();
   const bool last = !more || state.iteration + 1 >= state.options.max_steps;
-  bool changed = false;  // a unit of this call kept a new state
+  bool changed = restarted;  // a unit of this call kept a new state
   std::ostringstream what;
-  for (size_t k = reports_before; k < optimizer.reports().size(); ++k) {
-    const StepReport& r = optimizer.reports()[k];
+  for (size_t k = restarted ? 0 : reports_before; k < run.reports().size(); ++k) {
+    const StepReport& r = run.reports()[k];
+    if (r.phase == "initial") continue;
     changed |= r.accepted;
-    what << (k > reports_before ? "; " : "") << r.phase << " step " << r.step
+    what << (what.tellp() > 0 ? "; " : "") << r.phase << " step " << r.step
          << (r.accepted             ? " accepted"
              : r.phase != "descent" ? " kept nothing"
              : r.moved_nodes == 0   ? " converged"
                                     : " rejected (step size halved)");
   }
-  std::string prefix = what.str();
+  add(what.str());
+  for (const std::string& note : run.take_notes()) add(note);
   StepResult result;
-  if (last) {  // fold-over removal (and the earlier states it falls back to)
-    NodeOptResult end = optimizer.finish(&cancel);
-    job->optimizer.reset();
-    job->mesh = std::move(end.mesh);
-    job->layout = std::move(end.layout);
-    job->pipeline = std::move(end.pipeline);
-    if (end.orientation.ran) {
-      prefix += std::string(prefix.empty() ? "" : "; ") + "fold-overs " +
-                std::to_string(end.foldovers_descent) + " -> " +
-                std::to_string(end.foldovers_final) + " by orientation constraints";
+  if (last) {
+    OptimizeResult end = run.finish(&cancel);
+    for (const std::string& note : run.take_notes()) add(note);
+    job->run.reset();
+    job->pipeline = end.pipeline;
+    job->mesh = end.pipeline->mesh();
+    job->layout = end.pipeline->layout();
+    if (end.nodes && end.nodes->orientation.ran) {
+      const NodeOptResult& n = *end.nodes;
+      add("fold-overs " + std::to_string(n.foldovers_descent) + " -> " +
+          std::to_string(n.foldovers_final) + " by orientation constraints");
       // Infeasible constraints: the nodes next to the faces they could not unfold.
-      if (end.foldovers_final > 0 && !end.orientation.success) {
+      if (n.foldovers_final > 0 && !n.orientation.success) {
         const std::vector<int> near =
-            nodes_near_faces(job->mesh, job->layout, end.orientation.infeasible_faces);
+            nodes_near_faces(job->mesh, job->layout, n.orientation.infeasible_faces);
         if (!near.empty()) prefix += " (infeasible near " + describe_nodes(job->layout, near) + ")";
       }
     }
-    if (end.initial_reverted)
-      prefix += std::string(prefix.empty() ? "" : "; ") +
-                "the moved layouts could not be unfolded: back at the initial state";
-    else if (end.fewest_foldovers_reverted)
-      prefix += std::string(prefix.empty() ? "" : "; ") +
-                "unfolded at an earlier step (the one with the fewest fold-overs)";
-    // What `quadsketch-cli optimize` does by itself in these cases (its retries), offered.
-    std::vector<std::string> offers;
-    // The same rules as the command line's (core/nodeopt/retry.h); the user's current choice
-    // here is the check that the command line makes on explicit flags.
-    if (wants_keep_apart_retry(end) && !state.options.keep_nodes_apart)
-      offers.push_back("'Keep nodes apart'");
-    if (wants_sizing_retry(end) && !state.options.sizing) offers.push_back("'Sizing field'");
-    if (!offers.empty()) {
-      prefix += std::string(prefix.empty() ? "" : "; ");
-      if (end.foldovers_final > 0)
-        prefix += std::to_string(end.foldovers_final) + " fold-over(s) remain: ";
-      else if (end.untangled)
-        prefix += "only the untangling removed the fold-overs: ";
-      prefix += "turn on " + offers[0] + (offers.size() > 1 ? " or " + offers[1] : "") +
-                " and Run again (the command line retries with " +
-                (offers.size() > 1 ? "them" : "it") + " by itself)";
-    }
+    if (end.nodes && end.nodes->initial_reverted)
+      add("the moved layouts could not be unfolded: back at the initial state");
+    else if (end.nodes && end.nodes->fewest_foldovers_reverted)
+      add("unfolded at an earlier step (the one with the fewest fold-overs)");
     const double nodeopt_ms = ms_since(t);
     result = solve_for_display(*job, state, observer, true);
     result.metrics.nodeopt_ms = nodeopt_ms;
     result.finished = true;
   } else if (changed) {
-    job->mesh = optimizer.mesh();
-    job->layout = optimizer.layout();
-    job->pipeline = optimizer.pipeline(&cancel);
+    job->mesh = run.mesh();
+    job->layout = run.layout();
+    job->pipeline = run.pipeline(&cancel);
     const double nodeopt_ms = ms_since(t);
     result = solve_for_display(*job, state, observer, false);
     result.metrics.nodeopt_ms = nodeopt_ms;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/engine/optimize.h"
 #include "core/extract/quads.h"
 #include "core/extract/tracing.h"
 #include "core/layout/layout.h"
@@ -36,6 +37,10 @@ constexpr int kDefaultQuadCount = 400;
 
 //! One step of the editor's job. Throws QsError on failure, Cancelled when cancelled.
 StepResult pipeline_step(WorkerState& state, const WorkerObserver& observer);
+
+//! The engine settings of a job with \p options: the same run as `quadsketch-cli optimize`
+//! with the corresponding flags (core/engine/optimize.h).
+OptimizeSettings optimize_settings(const WorkerOptions& options);
 
 //! Which files write_job_exports writes.
 struct ExportSelection {

@@ -16,6 +16,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <stop_token>
 #include <string>
@@ -48,14 +49,16 @@ struct WorkerOptions {
   //! Iso-lines wrap around holes that only dangling arcs run into (--wrap-free-holes)
   bool wrap_free_holes = false;
   double anisotropy = 10.0;  //!< anisotropic norm factor of the parameterization energy
-  //! Curl-reducing sizing field (--sizing; SizingOptions::enabled: off by default)
-  bool sizing = SizingOptions{}.enabled;
+  //! Curl-reducing sizing field (--sizing / --no-sizing). Unset: off, and the run retries with it
+  //! when the fold-over removal fails (as `quadsketch-cli optimize` does).
+  std::optional<bool> sizing;
   double alpha = 0.75;            //!< initial damping α of node-optimization steps
   int descent_steps = 25;         //!< descent steps before the first hop sweep (--steps)
   bool keep_sharp_edges = false;  //!< sharp edges as feature curves (--keep-sharp-edges)
-  //! No moving node is carried next to another node (NodeOptOptions::keep_nodes_apart,
-  //! --keep-nodes-apart); the editor has no automatic retry with it.
-  bool keep_nodes_apart = false;
+  //! No moving node is carried next to another node (--keep-nodes-apart /
+  //! --no-keep-nodes-apart). Unset: off, and the run retries with it when the fold-over removal
+  //! fails or falls back (as `quadsketch-cli optimize` does).
+  std::optional<bool> keep_nodes_apart;
   //! Nodes sketched next to another node are moved apart before the node optimization
   //! (NodeOptOptions::separate_crowded_nodes, --separate-nodes).
   bool separate_nodes = false;
