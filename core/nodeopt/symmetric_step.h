@@ -56,9 +56,9 @@ std::optional<GeodesicTrace> symmetric_trace(const SymmetricTarget& target);
 //! and the symmetry.
 class SymmetricStepper {
  public:
-  //! \p original: the optimizer's original mesh (positions every relocation lies on), \p layout
-  //! its layout. \throw InvalidInputError when symmetry.node_mirror does not have one mutual
-  //! entry per node of \p layout.
+  //! \p original: the optimizer's original mesh (positions every relocation lies on; kept by
+  //! reference, it must outlive the stepper), \p layout its layout. \throw InvalidInputError when
+  //! symmetry.node_mirror does not have one mutual entry per node of \p layout.
   SymmetricStepper(const TriMesh& original, const Layout& layout,
                    std::shared_ptr<const NodeSymmetry> symmetry);
 
