@@ -476,4 +476,16 @@ TEST(GuiJob, LayoutPinReleasedMidRunLetsTheNodeMove) {
   EXPECT_FALSE(s->layout->nodes[n].pinned);
 }
 
+// A run that keeps the layout symmetric (WorkerOptions::symmetry, set by the editor's mirrored
+// sketching) on a sketch that is not symmetric fails, naming the first node without a mirror.
+TEST(GuiJob, SymmetricRunOfAnAsymmetricSketchFailsNamingTheNode) {
+  WorkerOptions options = steps(5);
+  options.symmetry = SymmetryAxis::X;
+  const SnapshotPtr s = test::run_job(example(), options);
+  ASSERT_TRUE(s);
+  EXPECT_EQ(s->status, WorkerStatus::Failed);
+  EXPECT_NE(s->message.find("not mirror symmetric"), std::string::npos) << s->message;
+  EXPECT_NE(s->message.find("node 0 (vertex 39)"), std::string::npos) << s->message;
+}
+
 }  // namespace qs::app

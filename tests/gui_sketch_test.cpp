@@ -15,12 +15,14 @@
 #include <thread>
 
 #include "app/gui/editor.h"
+#include "app/gui/pipeline_job.h"
 #include "app/gui/sketch_edits.h"
 #include "core/layout/layout_io.h"
 #include "core/layout/routing.h"
 #include "core/layout/symmetry.h"
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_io.h"
+#include "core/nodeopt/symmetric_step.h"
 #include "tests/scoped_env.h"
 #ifdef QS_TEST_RENDER
 #include "render/guide_layer.h"
@@ -88,6 +90,24 @@ int nearest_vertex(const TriMesh& mesh, const Vec3& p) {
       best = vh.idx();
     }
   return best;
+}
+
+// The vertices exactly \p rings edge rings away from vertex \p v.
+std::vector<int> ring_vertices(const TriMesh& mesh, int v, int rings) {
+  std::vector<int> depth(mesh.n_vertices(), -1);
+  std::vector<int> front{v};
+  depth[v] = 0;
+  for (int r = 1; r <= rings; ++r) {
+    std::vector<int> next;
+    for (int u : front)
+      for (const auto wh : mesh.vv_range(OpenMesh::VertexHandle(u)))
+        if (depth[wh.idx()] < 0) {
+          depth[wh.idx()] = r;
+          next.push_back(wh.idx());
+        }
+    front = std::move(next);
+  }
+  return front;
 }
 
 // The layout must pair up about the plane within 1e-6 of the diagonal.
@@ -312,6 +332,81 @@ TEST_F(GuiSketch, MirroredEdgeLoopKeepsTheLayoutSymmetric) {
   const SymmetryPairs after =
       match_mirror_pairs(mesh_of(editor), editor.doc.editor.layout(), editor.mirror()->plane);
   EXPECT_TRUE(after.symmetric()) << after.problem;
+}
+
+// Run with mirrored sketching on keeps a mirrored sketch symmetric: on the example bent about
+// x = 0 (still exactly mirror symmetric, but its lowest E no longer at symmetric cube corners),
+// the cube corners with an edge loop in the plane x = 0 (four nodes on the plane) and a corner
+// moved two rings (its mirror with it) end with the mirror pairs as mirror images and the plane
+// nodes in the plane.
+TEST_F(GuiSketch, RunKeepsAMirroredSketchSymmetric) {
+  TriMesh bent = load_mesh(kExampleMesh.string());
+  for (const auto vh : bent.vertices()) {
+    Vec3 p = bent.point(vh);
+    p[1] += 0.3 * p[0] * p[0];
+    p[2] *= 1 + 0.15 * p[1];
+    bent.set_point(vh, p);
+  }
+  const fs::path bent_path = dir_ / "bent_ellipsoid.obj";
+  save_mesh_obj(bent, bent_path.string());
+  Editor editor(config());
+  ASSERT_TRUE(editor.start(bent_path.string(), kExactLayout.string()));
+  editor.symmetry.enable(SymmetryAxis::X);
+  ASSERT_TRUE(poll_until(editor, [&] { return editor.mirror() != nullptr; }));
+  const TriMesh& mesh = mesh_of(editor);
+  const Mirror& m = *editor.mirror();
+  LayoutEditor& e = editor.doc.editor;
+  const SymmetryPairs cube = match_mirror_pairs(mesh, e.layout(), m.plane);
+  int crossing = -1;
+  for (int a = 0; a < int(e.layout().arcs.size()) && crossing < 0; ++a)
+    if (cube.arc_mirror[a] == a) crossing = e.layout().arcs[a].id;
+  ASSERT_GE(crossing, 0);
+  editor.insert_edge_loop(crossing);
+  ASSERT_EQ(e.layout().nodes.size(), 12u) << editor.status();
+  const LayoutNode corner = e.layout().nodes[0];
+  bool moved = false;
+  for (int v : ring_vertices(mesh, corner.vertex, 2))
+    if (sketch_move_node(e, &m, corner.id, v)) {
+      moved = true;
+      break;
+    }
+  ASSERT_TRUE(moved);
+  editor.poll();
+  ASSERT_TRUE(editor.doc.validation.valid());
+  expect_symmetric(editor);
+  const Layout sketch = e.layout();
+  SymmetryPairOptions exact;
+  exact.tolerance = 1e-6;
+  const NodeSymmetry pairs{m.plane, match_mirror_pairs(mesh, sketch, m.plane, exact).node_mirror};
+
+  editor.job.options.publish_interval_ms = 0;
+  editor.run();
+  ASSERT_TRUE(poll_until(
+      editor,
+      [&] {
+        const SnapshotPtr& s = editor.job.latest();
+        return s && (s->status == WorkerStatus::Finished || s->status == WorkerStatus::Failed);
+      },
+      120s));
+  const Snapshot* s = editor.result();
+  ASSERT_TRUE(s && s->exports) << editor.job.latest()->message;
+  EXPECT_EQ(s->status, WorkerStatus::Finished) << s->message;
+  const JobExports& out = *s->exports;
+  ASSERT_EQ(out.layout.nodes.size(), sketch.nodes.size());
+  double travel = 0;
+  for (std::size_t k = 0; k < sketch.nodes.size(); ++k) {
+    ASSERT_EQ(out.layout.nodes[k].id, sketch.nodes[k].id);
+    travel = std::max(travel, (position(out.mesh, out.layout.nodes[k].vertex) -
+                               position(mesh, sketch.nodes[k].vertex))
+                                  .norm());
+  }
+  EXPECT_GT(travel, 0.02);  // the run moved the nodes (the mean edge is 0.14)
+  const NodeSymmetryMeasure measure = measure_node_symmetry(out.mesh, out.layout, pairs);
+  EXPECT_EQ(measure.pairs, 4);
+  EXPECT_EQ(measure.plane_nodes, 4);
+  EXPECT_LT(measure.max_pair_error, 1e-6);
+  EXPECT_LT(measure.max_plane_error, 1e-6);
+  EXPECT_EQ(s->metrics.foldovers, 0);
 }
 
 TEST_F(GuiSketch, FieldHintsAreComputedInTheBackgroundOncePerMesh) {

@@ -144,6 +144,14 @@ int run_cli(int argc, char** argv) {
                     "Before the node optimization, move nodes that sit next to another node "
                     "(on its vertex's 1-ring) apart, at most 2 edge rings; for displaced "
                     "sketches with crowded nodes, best with --keep-nodes-apart");
+  cmd_opt
+      ->add_option("--symmetry", opt.symmetry,
+                   "Keep the layout mirror symmetric about the plane x, y or z = const through "
+                   "the mesh's bounding-box centre, or the fitted mirror plane (auto): mirror "
+                   "pairs of nodes move as mirror images and nodes on the plane stay in it. The "
+                   "pairs are found from the layout, which must be symmetric (an error names the "
+                   "first node without a mirror); no hop polish, nodes on curves stay")
+      ->check(CLI::IsMember({"x", "y", "z", "auto"}));
   cmd_opt->add_flag("--orientation", opt.orientation,
                     "With --no-node-opt: when the parameterization has fold-overs, solve it "
                     "again with strict orientation constraints (the fixed nodes' fold-over "

@@ -18,9 +18,11 @@
 #include "core/engine/optimize.h"
 #include "core/extract/quads.h"
 #include "core/layout/layout_io.h"
+#include "core/layout/symmetry.h"
 #include "core/mesh/mesh_io.h"
 #include "core/nodeopt/gradient.h"
 #include "core/nodeopt/optimizer.h"
+#include "core/nodeopt/symmetric_step.h"
 #include "core/pipeline/integer_sizes.h"
 #include "core/pipeline/pipeline.h"
 
@@ -122,6 +124,7 @@ OptimizeSettings optimize_settings(const OptimizeOptions& o) {
   s.nodes.keep_apart = o.keep_nodes_apart;
   s.nodes.separate_crowded = o.separate_nodes;
   s.nodes.time_limit_s = o.time_limit_s;
+  if (!o.symmetry.empty()) s.nodes.symmetry = parse_symmetry_axis(o.symmetry);
   if (o.no_orientation) s.folds.remove = false;
   if (o.orientation) s.folds.remove = true;
   s.folds.sectors = o.orientation_sectors == "field"      ? SectorFrame::kField
@@ -176,6 +179,10 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
           "--discrete-relocation)");
     if (o.orientation && o.no_orientation)
       throw InvalidInputError("--orientation and --no-orientation contradict each other");
+    if (!o.symmetry.empty() && (o.no_node_opt || o.discrete_relocation || o.separate_nodes))
+      throw InvalidInputError(
+          "--symmetry applies to the continuous node optimization (not --no-node-opt, "
+          "--discrete-relocation or --separate-nodes)");
     // The whole policy (node optimization, retries, integer sizes) is the engine's
     // (core/engine/optimize.h), the same that the editor's Run drives step by step.
     const OptimizeSettings settings = optimize_settings(o);
@@ -280,6 +287,24 @@ int run_optimize(const OptimizeOptions& o, const CommonOptions& common) {
       }
       warn_about_infeasible_orientation(node_result->orientation, param.foldovers, pipeline.mesh(),
                                         pipeline.layout());
+    }
+    if (result.symmetry) {  // measured on the written state
+      const NodeSymmetry& sym = *result.symmetry;
+      const NodeSymmetryMeasure sm = measure_node_symmetry(pipeline.mesh(), pipeline.layout(), sym);
+      const MirrorPlane& p = sym.plane;
+      report["symmetry"] = {{"plane",
+                             {{"axis", o.symmetry},
+                              {"normal", {p.normal[0], p.normal[1], p.normal[2]}},
+                              {"offset", p.offset}}},
+                            {"pairs", sm.pairs},
+                            {"plane_nodes", sm.plane_nodes},
+                            {"max_pair_error", sm.max_pair_error},
+                            {"max_plane_error", sm.max_plane_error}};
+      if (!common.quiet)
+        std::cerr << "optimize: symmetric about the plane " << describe_plane(p) << ": " << sm.pairs
+                  << " mirror pair(s), " << sm.plane_nodes
+                  << " node(s) on the plane, largest error "
+                  << std::max(sm.max_pair_error, sm.max_plane_error) << " of the diagonal\n";
     }
     if (o.orientation) {  // --no-node-opt --orientation
       const OrientationReport& r = param.orientation;

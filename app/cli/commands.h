@@ -65,6 +65,9 @@ struct OptimizeOptions {
   int threads = 1;               //!< math-library threads (core/base/solver_threads.h)
   //! Wall-clock seconds for moving nodes (all node optimization runs together); 0: no limit.
   double time_limit_s = 0;
+  //! Symmetric optimization about the plane of this axis ("x", "y", "z" or "auto",
+  //! OptimizeSettings::Nodes::symmetry); "": off.
+  std::string symmetry;
 };
 
 //! import-quads welds the quad mesh's vertices closer than this × its bounding-box diagonal.

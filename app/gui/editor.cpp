@@ -322,6 +322,15 @@ std::string Editor::run_blocker() {
   return {};
 }
 
+void Editor::symmetry_to_job() {
+  WorkerOptions& o = job.options;
+  o.symmetry.reset();
+  o.symmetry_plane.reset();
+  if (!symmetry.enabled()) return;
+  o.symmetry = symmetry.axis();
+  if (const Mirror* m = symmetry.mirror()) o.symmetry_plane = m->plane;
+}
+
 void Editor::run() {
   if (job.running()) return;
   if (!job.paused()) {
@@ -330,6 +339,7 @@ void Editor::run() {
       return;
     }
   }
+  symmetry_to_job();
   job.run(doc);
   set_status(job.paused() ? "Running on" : "Running");
 }
@@ -342,6 +352,7 @@ void Editor::step() {
       return;
     }
   }
+  symmetry_to_job();
   job.step(doc);
   set_status("One step");
 }

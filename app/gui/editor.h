@@ -95,6 +95,8 @@ class Editor {
   // The pipeline.
   //! Why Run / Step cannot start now ("" when they can).
   std::string run_blocker();
+  //! Run and Step start a run that keeps the layout mirror symmetric while mirrored sketching
+  //! is on (WorkerOptions::symmetry and symmetry_plane).
   void run();
   void step();
   void pause();
@@ -150,6 +152,8 @@ class Editor {
 
  private:
   void on_layout_edited(const Layout& layout);
+  //! The mirrored sketching's axis and plane (when computed) into the job's options.
+  void symmetry_to_job();
   //! After the whole layout was replaced (open, restore): selection reset, worker reloaded.
   void after_document_changed();
 

@@ -89,7 +89,8 @@ void draw_pipeline_options(AppContext& ctx) {
   ImGui::Checkbox("Separate crowded nodes", &o.separate_nodes);
   tooltip(
       "Before the node optimization, nodes sketched next to another node (on its 1-ring) "
-      "move apart, at most 2 edge rings, keeping every patch (--separate-nodes)");
+      "move apart, at most 2 edge rings, keeping every patch (--separate-nodes; not with "
+      "Mirror on, whose Run keeps the layout symmetric)");
   float alpha = float(o.alpha);
   if (ImGui::SliderFloat("alpha (damping)", &alpha, 0.05f, 1.0f, "%.2f")) o.alpha = alpha;
   tooltip("Initial damping factor of the node steps; halved after a rejected step");

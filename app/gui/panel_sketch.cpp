@@ -20,7 +20,8 @@ void draw_symmetry(AppContext& ctx) {
   tooltip(
       "Symmetric sketching: nodes and arcs drawn on one side appear mirrored on the other; "
       "moves, splits, deletes, pins and edge loops are mirrored too; a node placed near the "
-      "plane goes onto it and stays on it.");
+      "plane goes onto it and stays on it. Run keeps the layout symmetric: mirror pairs move "
+      "as mirror images, nodes on the plane stay in it.");
   ImGui::SameLine();
   int axis = int(symmetry.axis());
   ImGui::SetNextItemWidth(9.0f * ImGui::GetFontSize());

@@ -87,6 +87,10 @@ OptimizeSettings optimize_settings(const WorkerOptions& o) {
   s.nodes.separate_crowded = o.node_optimization && o.separate_nodes;
   if (!o.node_optimization) s.folds.remove = o.remove_foldovers;
   s.folds.untangle = o.untangle;
+  if (o.node_optimization) {  // a fixed-node run has nothing to keep symmetric
+    s.nodes.symmetry = o.symmetry;
+    s.nodes.symmetry_plane = o.symmetry_plane;
+  }
   return s;
 }
 

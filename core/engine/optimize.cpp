@@ -53,6 +53,10 @@ std::shared_ptr<Pipeline> fixed_pipeline(const TriMesh& mesh, const Layout& layo
 
 }  // namespace
 
+bool symmetric(const OptimizeSettings& s) {
+  return s.nodes.symmetry || s.nodes.symmetry_plane;
+}
+
 void validate_settings(const OptimizeSettings& s) {
   require(std::isfinite(s.field.sharp_angle_deg) && s.field.sharp_angle_deg > 0 &&
               s.field.sharp_angle_deg <= 180,
@@ -76,6 +80,21 @@ void validate_settings(const OptimizeSettings& s) {
         "separating crowded nodes applies to the continuous node optimization only");
   if (s.nodes.time_limit_s > 0 && !s.nodes.enabled)
     throw InvalidInputError("a time limit applies to the node optimization only");
+  if (symmetric(s)) {
+    if (!s.nodes.enabled || s.nodes.method == NodeMethod::kDiscrete)
+      throw InvalidInputError(
+          "symmetric optimization applies to the continuous node optimization only");
+    if (s.nodes.separate_crowded)
+      throw InvalidInputError(
+          "separating crowded nodes moves single nodes: not with symmetric optimization");
+  }
+  if (s.nodes.symmetry_plane) {
+    const MirrorPlane& p = *s.nodes.symmetry_plane;
+    const double length = p.normal.norm();
+    require(std::isfinite(length) && std::abs(length - 1) <= 1e-6, "nodes.symmetry_plane.normal",
+            length, "of length 1");
+    require(std::isfinite(p.offset), "nodes.symmetry_plane.offset", p.offset, "finite");
+  }
 }
 
 PipelineOptions pipeline_options(const OptimizeSettings& s) {
@@ -319,10 +338,21 @@ OptimizeRun::OptimizeRun(TriMesh mesh, Layout layout, const OptimizeSettings& se
   m.base_node_options = node_options(settings);
   m.input_mesh = std::move(mesh);
   m.input_layout = std::move(layout);
+  if (symmetric(settings)) {
+    // The plane and the pairs once, on the input: every run (retries, the integer run) keeps
+    // them, and a layout that is not symmetric is refused here, naming its first unpaired node.
+    MirrorPlane plane;
+    if (settings.nodes.symmetry_plane) {
+      plane = *settings.nodes.symmetry_plane;
+    } else {
+      const ClosestPointTree tree(m.input_mesh);
+      plane = mirror_plane(m.input_mesh, tree, *settings.nodes.symmetry).plane;
+    }
+    m.base_node_options.symmetry = make_node_symmetry(m.input_mesh, m.input_layout, plane);
+    m.result.symmetry = m.base_node_options.symmetry;
+  }
   if (!m.moving()) {
     m.stage = Impl::Stage::kDone;  // the one solve is made by pipeline() or the caller
-    return;
-    m.stage = Impl::Stage::kDone;
     return;
   }
   if (settings.nodes.time_limit_s > 0)

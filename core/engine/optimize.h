@@ -12,8 +12,10 @@
 
 #include "core/base/progress.h"
 #include "core/layout/layout.h"
+#include "core/layout/symmetry.h"
 #include "core/mesh/mesh.h"
 #include "core/nodeopt/optimizer.h"
+#include "core/nodeopt/symmetric_step.h"
 #include "core/pipeline/integer_sizes.h"
 #include "core/pipeline/pipeline.h"
 
@@ -48,6 +50,14 @@ struct OptimizeSettings {
     std::optional<bool> keep_apart;
     bool separate_crowded = false;  //!< nodes next to another node move apart first
     double time_limit_s = 0;        //!< wall-clock budget for moving nodes (0: none)
+    //! Keep the layout mirror symmetric (docs/design.md, "Symmetric optimization"; continuous
+    //! node optimization only, not with separate_crowded): the plane of this axis through the
+    //! mesh's bounding-box centre, or fitted (mirror_plane). Unset: off unless symmetry_plane is
+    //! set.
+    std::optional<SymmetryAxis> symmetry;
+    //! The mirror plane itself (e.g. the editor's, already fitted): used instead of computing
+    //! the plane of `symmetry`, and turns symmetry on. Unit normal, finite offset.
+    std::optional<MirrorPlane> symmetry_plane;
   } nodes;
   struct Folds {
     //! Remove fold-overs with orientation constraints: with moving nodes at the end of each
@@ -68,6 +78,8 @@ struct OptimizeSettings {
 
 //! Checks \p settings; \throw InvalidInputError naming the setting and its value.
 void validate_settings(const OptimizeSettings& settings);
+//! Symmetric optimization is on (nodes.symmetry or nodes.symmetry_plane set).
+bool symmetric(const OptimizeSettings& settings);
 
 //! The solver options that \p settings mean (the field and parameterization options of the
 //! first attempt, before any retry).
@@ -102,20 +114,25 @@ struct OptimizeResult {
   bool keep_nodes_apart = false;  //!< of the kept run
   std::optional<RetryRecord> keep_apart_retry, sizing_retry;
   std::optional<IntegerSizes> integer;
-  double E_relaxed = 0;       //!< unweighted E of the relaxed solve (integer sizes)
+  double E_relaxed = 0;  //!< unweighted E of the relaxed solve (integer sizes)
+  //! With symmetric optimization: the plane and the node pairs every run kept (found once on
+  //! the input layout; measure_node_symmetry measures them on the result). Null when off.
+  std::shared_ptr<const NodeSymmetry> symmetry;
   double node_time_s = 0;     //!< wall-clock time of every node optimization run
   bool time_limited = false;  //!< the time limit ended a node movement
 };
 
-//! An optimize run one unit at a time: construction is the initial solve, each step() one
+//! An optimize run one unit at a time: construction is the initial solve (with symmetric
+//! optimization first the plane and the mirror pairs of the input layout), each step() one
 //! descent step or hop sweep of the current node optimization; when one ends, step() removes
 //! its fold-overs and starts the next run the policy asks for (a retry from the input, or the
 //! integer run) with its initial solve. finish() ends the run and returns the result; with all
 //! steps taken it equals optimize(). Not thread-safe: one thread drives it.
 class OptimizeRun {
  public:
-  //! \throw InvalidInputError (settings, invalid layout), TopologyError, SolverError,
-  //! Cancelled.
+  //! \throw InvalidInputError (settings, invalid layout, a layout that is not symmetric about
+  //! the plane of symmetric optimization: find_mirror_pairs's message naming the first node
+  //! without a mirror), TopologyError, SolverError, Cancelled.
   OptimizeRun(TriMesh mesh, Layout layout, const OptimizeSettings& settings,
               Observer* observer = nullptr);
   ~OptimizeRun();

@@ -17,6 +17,7 @@
 #include "core/layout/validate.h"
 #include "core/nodeopt/discrete.h"
 #include "core/nodeopt/geodesic.h"
+#include "core/nodeopt/symmetric_step.h"
 
 namespace qs {
 
@@ -204,6 +205,8 @@ struct NodeOptimizer::Impl {
   bool current_solved = true;
   // Re-routing keeps the patch count: computed once.
   const RerouteContext reroute;
+  // Symmetric optimization (NodeOptOptions::symmetry; null when off).
+  const std::unique_ptr<const SymmetricStepper> symmetric;
   double alpha;
   // Gradients and node-Voronoi cells depend on the state only: kept across rejected steps.
   std::vector<Vec3> grad;
@@ -250,6 +253,9 @@ struct NodeOptimizer::Impl {
         mean_edge(original_geometry.mean_edge_length),
         curves(curve_network(mesh, original_geometry, layout, options_in, no_in)),
         reroute(make_reroute_context(mesh, layout)),
+        symmetric(no_in.symmetry
+                      ? std::make_unique<const SymmetricStepper>(original, layout, no_in.symmetry)
+                      : nullptr),
         alpha(no_in.alpha),
         step_budget(no_in.max_steps) {
     for (const auto& n : layout.nodes) state.anchor.push_back(vertex_surface_point(mesh, n.vertex));
@@ -822,10 +828,26 @@ struct NodeOptimizer::Impl {
       ++counters.gradient_reuses;
     }
 
+    // The step of movable node i from \p anchor, traced on the original mesh; nullopt when it
+    // is shorter than the step resolution.
+    auto trace_step = [&](size_t i, const SurfacePoint& anchor) -> std::optional<GeodesicTrace> {
+      const int n = movable[i];
+      const double len = alpha * damping[i] * scale * grad[i].norm();
+      if (len < no.min_step_relative * mean_edge) return std::nullopt;
+      auto blocked = [&](int f) {
+        if (!no.voronoi_safeguard) return false;
+        for (auto vh : original.fv_range(original.face_handle(f)))
+          if (cell[vh.idx()] == n || cell[vh.idx()] < 0) return false;
+        return true;
+      };
+      return trace_straightest_geodesic(original, anchor, -grad[i] / grad[i].norm(), len, blocked);
+    };
     // Builds the trial state; nodes with no_switch[i] set may only move within faces of their
-    // current vertex's original 1-ring.
-    auto build_trial = [&](const std::vector<char>& no_switch, State& trial,
-                           std::vector<char>& switched) {
+    // current vertex's original 1-ring. \p sym (symmetric optimization; empty when off): per
+    // node, the target that replaces its own step.
+    auto build_trial_to = [&](const std::vector<char>& no_switch,
+                              const std::vector<SymmetricTarget>& sym, State& trial,
+                              std::vector<char>& switched) {
       trial = state;
       switched.assign(movable.size(), 0);
       target.assign(movable.size(), -1);
@@ -840,16 +862,10 @@ struct NodeOptimizer::Impl {
           moved += slide_on_curve(trial, i, n, no_switch[i], obstacles, switched);
           continue;
         }
-        const double len = alpha * damping[i] * scale * grad[i].norm();
-        if (len < no.min_step_relative * mean_edge) continue;
-        auto blocked = [&](int f) {
-          if (!no.voronoi_safeguard) return false;
-          for (auto vh : original.fv_range(original.face_handle(f)))
-            if (cell[vh.idx()] == n || cell[vh.idx()] < 0) return false;
-          return true;
-        };
-        const GeodesicTrace tr = trace_straightest_geodesic(
-            original, trial.anchor[n], -grad[i] / grad[i].norm(), len, blocked);
+        const std::optional<GeodesicTrace> step =
+            sym.empty() ? trace_step(i, trial.anchor[n]) : symmetric_trace(sym[n]);
+        if (!step) continue;
+        const GeodesicTrace& tr = *step;
         const int v = trial.layout.nodes[n].vertex;
         // A step that ends next to a vertex on a sharp edge or feature curve takes the node onto
         // that vertex at its place (such vertices are not relocated for nodes off the curves).
@@ -902,6 +918,23 @@ struct NodeOptimizer::Impl {
       }
       return moved;
     };
+    // ---- symmetric optimization (NodeOptOptions::symmetry; symmetric_step.h) ----
+    // The trial of the step's targets made symmetric, built again without the pairs it could not
+    // realize as mirror images.
+    auto build_trial = [&](const std::vector<char>& no_switch, State& trial,
+                           std::vector<char>& switched) {
+      if (!symmetric) return build_trial_to(no_switch, {}, trial, switched);
+      std::vector<SymmetricTarget> sym = symmetric->targets(state.anchor, movable, [&](size_t i) {
+        const std::optional<GeodesicTrace> tr = trace_step(i, state.anchor[movable[i]]);
+        return tr ? std::optional<SurfacePoint>(tr->end) : std::nullopt;
+      });
+      for (;;) {
+        const int moved = build_trial_to(no_switch, sym, trial, switched);
+        if (!symmetric->hold_unmatched(state.mesh, state.layout, trial.mesh, trial.layout, sym))
+          return moved;
+      }
+    };
+    // ---- end of symmetric optimization ----
     // A trial without switches has state's layout: re-solve the current Pipeline in place.
     auto try_evaluate = [&](const State& trial, const std::vector<char>& switched,
                             Evaluation& next) {
@@ -1434,8 +1467,10 @@ std::optional<SeparateNodesResult> separate_movable_nodes(const TriMesh& mesh,
 }
 
 NodeOptimizer::NodeOptimizer(const TriMesh& mesh, const Layout& layout,
-                             const PipelineOptions& options, const NodeOptOptions& node_options,
+                             const PipelineOptions& options, const NodeOptOptions& given_options,
                              Observer* observer, std::shared_ptr<Pipeline> start) {
+  // Symmetric optimization: what moves single nodes off (symmetric_step.h).
+  const NodeOptOptions node_options = symmetric_node_options(given_options);
   std::optional<SeparateNodesResult> separated;
   if (node_options.separate_crowded_nodes) separated = separate_movable_nodes(mesh, layout);
   const bool moved = separated && !separated->moved_nodes.empty();

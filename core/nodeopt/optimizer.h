@@ -23,6 +23,8 @@ namespace qs {
 
 enum class GradientMethod { Estimator, Exact };
 
+struct NodeSymmetry;  // core/nodeopt/symmetric_step.h
+
 //! Settings of the node optimization (docs/design.md, "Node optimization"). Lengths relative to
 //! the mean edge length unless stated; angles in degrees where the name says so.
 struct NodeOptOptions {
@@ -205,6 +207,15 @@ struct NodeOptOptions {
   bool orientation_at_moved_states = true;
   bool stiffen_at_end = true;  //!< stiffening when fold-overs remain after that
   StiffeningOptions stiffening;
+  // ---- symmetry (docs/design.md, "Symmetric optimization") ----
+  //! Keep the layout mirror symmetric (core/nodeopt/symmetric_step.h): every descent step's
+  //! targets are symmetrized (a pair moves as mirror images about the plane, a node that is its
+  //! own mirror moves in the plane; a held node's mirror follows it), a trial in which a pair
+  //! could not be realized as mirror images is built again with that pair held, and what moves
+  //! single nodes is off (symmetric_node_options: hop polish, sliding along curves, separation
+  //! of crowded nodes). Its node_mirror has one entry per layout node. Null: off.
+  std::shared_ptr<const NodeSymmetry> symmetry;
+
   //! Ends the node movement early when it returns true (a time limit): polled before each
   //! descent step and hop sweep and before each candidate solve inside a sweep. The state
   //! reached so far is kept (a sweep keeps the hops it made), finish() still removes

@@ -26,6 +26,7 @@
 #include "core/base/progress.h"
 #include "core/field/cross_field.h"
 #include "core/layout/layout.h"
+#include "core/layout/symmetry.h"
 #include "core/mesh/mesh.h"
 #include "core/param/sizing.h"
 #include "core/pipeline/snapshot.h"
@@ -69,6 +70,12 @@ struct WorkerOptions {
   //! Where the orientation constraints leave fold-overs, untangle the parameterization
   //! (OrientationOptions::untangle; --no-untangle turns it off).
   bool untangle = true;
+  //! Keep the layout mirror symmetric about the plane of this axis (`optimize --symmetry`,
+  //! OptimizeSettings::Nodes::symmetry). Unset: off unless symmetry_plane is set. The editor
+  //! sets both from its mirrored sketching when a run starts.
+  std::optional<SymmetryAxis> symmetry;
+  //! The mirror plane, when already computed (the editor's): used instead of the axis's.
+  std::optional<MirrorPlane> symmetry_plane;
 };
 
 //! What a step function sees of the job: a qs::Observer, so it can be handed straight to
