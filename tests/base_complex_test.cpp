@@ -1,5 +1,5 @@
-// Tests of the base complex of quad meshes (core/layout/base_complex.h).
-#include "core/layout/base_complex.h"
+// Tests of the base complex of quad meshes (core/import/base_complex.h).
+#include "core/import/base_complex.h"
 
 #include <gtest/gtest.h>
 

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "core/layout/base_complex.h"
+#include "core/import/base_complex.h"
+#include "core/import/quad_import.h"
 #include "core/layout/layout.h"
-#include "core/layout/quad_import.h"
 #include "core/mesh/mesh.h"
 
 namespace qs {

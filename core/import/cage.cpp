@@ -1,4 +1,4 @@
-#include "core/layout/cage.h"
+#include "core/import/cage.h"
 
 #include <algorithm>
 #include <cmath>

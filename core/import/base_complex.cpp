@@ -1,4 +1,4 @@
-#include "core/layout/base_complex.h"
+#include "core/import/base_complex.h"
 
 #include <algorithm>
 #include <array>

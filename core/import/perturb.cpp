@@ -1,4 +1,4 @@
-#include "core/layout/perturb.h"
+#include "core/import/perturb.h"
 
 #include <algorithm>
 #include <limits>
