@@ -1,4 +1,5 @@
-// Tests of layout perturbation (core/import/perturb.h) and `quadsketch-cli perturb`.
+// Tests of layout perturbation (core/import/perturb.h), of separate_nodes
+// (core/layout/node_shift.h) and of `quadsketch-cli perturb`.
 #include "core/import/perturb.h"
 
 #include <gtest/gtest.h>
