@@ -1,4 +1,5 @@
-// Tests of the base complex of quad meshes (core/import/base_complex.h).
+// Tests of the base complex of quad meshes (core/import/base_complex.h) and its coarsening
+// (core/import/coarsen.h).
 #include "core/import/base_complex.h"
 
 #include <gtest/gtest.h>
@@ -6,6 +7,7 @@
 #include <algorithm>
 
 #include "core/base/errors.h"
+#include "core/import/coarsen.h"
 #include "core/mesh/mesh_io.h"
 #include "tests/fixtures.h"
 

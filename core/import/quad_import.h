@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/import/base_complex.h"
+#include "core/import/coarsen.h"
 #include "core/import/quad_triangulation.h"
 #include "core/import/transfer.h"
 #include "core/layout/layout.h"
