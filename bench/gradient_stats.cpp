@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "core/base/allocator.h"
+#include "core/import/perturb.h"
 #include "core/layout/layout_io.h"
-#include "core/layout/perturb.h"
 #include "core/mesh/mesh_io.h"
 #include "core/nodeopt/gradient.h"
 #include "core/pipeline/pipeline.h"

@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "core/layout/quad_import.h"
+#include "core/import/quad_import.h"
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_io.h"
 #include "fuzz/fuzz_common.h"

@@ -1,11 +1,13 @@
-// Tests of the base complex of quad meshes (core/layout/base_complex.h).
-#include "core/layout/base_complex.h"
+// Tests of the base complex of quad meshes (core/import/base_complex.h) and its coarsening
+// (core/import/coarsen.h).
+#include "core/import/base_complex.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
 #include "core/base/errors.h"
+#include "core/import/coarsen.h"
 #include "core/mesh/mesh_io.h"
 #include "tests/fixtures.h"
 

@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "core/field/cross_field.h"
-#include "core/layout/quad_import.h"
+#include "core/import/quad_import.h"
 #include "core/layout/routing.h"
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_checks.h"

@@ -1,6 +1,6 @@
-// Voxel-cage layouts for meshes without any quad structure (core/layout/cage.h), and the tests
+// Voxel-cage layouts for meshes without any quad structure (core/import/cage.h), and the tests
 // of issues #3 and #4 they make possible on the shared real meshes.
-#include "core/layout/cage.h"
+#include "core/import/cage.h"
 
 #include <gtest/gtest.h>
 

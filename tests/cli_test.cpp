@@ -10,8 +10,8 @@
 #include <regex>
 #include <sstream>
 
+#include "core/import/perturb.h"
 #include "core/layout/layout_io.h"
-#include "core/layout/perturb.h"
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_io.h"
 #include "tests/fixtures.h"

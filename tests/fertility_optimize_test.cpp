@@ -13,7 +13,7 @@
 #include <memory>
 #include <string>
 
-#include "core/layout/cage.h"
+#include "core/import/cage.h"
 #include "core/layout/layout_io.h"
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_io.h"

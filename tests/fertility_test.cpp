@@ -1,6 +1,6 @@
 // Issues #3 and #4 on fertility.obj (genus 4, 27954 faces). The model has no licence statement,
 // so neither it nor a layout derived from it is shipped: the layout is a voxel-cage layout
-// (core/layout/cage.h) generated here from ../shared, once per test binary. The tests skip when
+// (core/import/cage.h) generated here from ../shared, once per test binary. The tests skip when
 // ../shared is absent.
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <string>
 
 #include "core/field/cross_field.h"
-#include "core/layout/cage.h"
+#include "core/import/cage.h"
 #include "core/layout/validate.h"
 #include "core/mesh/geometry.h"
 #include "core/mesh/mesh_checks.h"

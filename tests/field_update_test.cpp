@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "core/field/cross_field.h"
-#include "core/layout/cage.h"
+#include "core/import/cage.h"
 #include "core/layout/validate.h"
 #include "core/mesh/geometry.h"
 #include "core/mesh/mesh_io.h"

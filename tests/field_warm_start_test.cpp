@@ -7,7 +7,7 @@
 #include <cstdio>
 
 #include "core/field/cross_field.h"
-#include "core/layout/cage.h"
+#include "core/import/cage.h"
 #include "core/layout/validate.h"
 #include "core/mesh/geometry.h"
 #include "core/mesh/mesh_io.h"

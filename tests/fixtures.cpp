@@ -16,9 +16,9 @@
 #include <stdexcept>
 
 #include "core/field/cross_field.h"
+#include "core/import/perturb.h"
+#include "core/import/quad_import.h"
 #include "core/layout/layout_io.h"
-#include "core/layout/perturb.h"
-#include "core/layout/quad_import.h"
 #include "core/layout/routing.h"
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_checks.h"

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "core/extract/tracing.h"
-#include "core/layout/cage.h"
+#include "core/import/cage.h"
 #include "core/layout/layout.h"
 #include "core/mesh/geometry.h"
 #include "core/mesh/mesh.h"

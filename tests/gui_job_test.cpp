@@ -11,8 +11,8 @@
 
 #include "app/gui/history.h"
 #include "app/gui/pipeline_job.h"
+#include "core/import/perturb.h"
 #include "core/layout/layout_io.h"
-#include "core/layout/perturb.h"
 #include "core/mesh/mesh_io.h"
 #include "core/nodeopt/optimizer.h"
 #include "core/pipeline/pipeline.h"

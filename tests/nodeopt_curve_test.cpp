@@ -7,7 +7,7 @@
 #include <cstdio>
 
 #include "core/field/curvature.h"
-#include "core/layout/perturb.h"
+#include "core/import/perturb.h"
 #include "core/layout/validate.h"
 #include "core/mesh/geometry.h"
 #include "core/nodeopt/discrete.h"

@@ -9,10 +9,10 @@
 #include <queue>
 #include <thread>
 
-#include "core/layout/base_complex.h"
+#include "core/import/base_complex.h"
+#include "core/import/perturb.h"
+#include "core/import/quad_import.h"
 #include "core/layout/layout_io.h"
-#include "core/layout/perturb.h"
-#include "core/layout/quad_import.h"
 #include "core/layout/validate.h"
 #include "core/mesh/geometry.h"
 #include "core/mesh/mesh_io.h"
@@ -341,7 +341,7 @@ test::MeshAndLayout pentagonal_prism(int k, Vec3 radii) {
 }
 
 // Recovery (issue #5): optimize the exact layout (E*), displace every node by 3 rings
-// (core/layout/perturb) and optimize again.
+// (core/import/perturb) and optimize again.
 struct RecoveryOutcome {
   double E_star = 0, E_init = 0, E_final = 0;
   int foldovers_final = 0, hop_rounds = 0, hops = 0;

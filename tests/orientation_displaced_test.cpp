@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "core/layout/perturb.h"
-#include "core/layout/quad_import.h"
+#include "core/import/perturb.h"
+#include "core/import/quad_import.h"
 #include "core/mesh/mesh_io.h"
 #include "core/nodeopt/optimizer.h"
 #include "core/param/orientation.h"

@@ -15,9 +15,9 @@
 #include <nlohmann/json.hpp>
 
 #include "core/base/errors.h"
+#include "core/import/perturb.h"
+#include "core/import/quad_import.h"
 #include "core/layout/layout_io.h"
-#include "core/layout/perturb.h"
-#include "core/layout/quad_import.h"
 #include "core/mesh/mesh_checks.h"
 #include "core/mesh/mesh_io.h"
 #include "core/nodeopt/gradient.h"

@@ -8,7 +8,7 @@
 
 #include "core/extract/metrics.h"
 #include "core/field/curvature.h"
-#include "core/layout/quad_import.h"
+#include "core/import/quad_import.h"
 #include "core/mesh/mesh_io.h"
 #include "core/pipeline/pipeline.h"
 #include "tests/fixtures.h"

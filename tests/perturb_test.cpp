@@ -1,5 +1,6 @@
-// Tests of layout perturbation (core/layout/perturb.h) and `quadsketch-cli perturb`.
-#include "core/layout/perturb.h"
+// Tests of layout perturbation (core/import/perturb.h), of separate_nodes
+// (core/layout/node_shift.h) and of `quadsketch-cli perturb`.
+#include "core/import/perturb.h"
 
 #include <gtest/gtest.h>
 
@@ -9,8 +10,8 @@
 
 #include "core/base/atomic_file.h"
 #include "core/base/errors.h"
+#include "core/import/quad_import.h"
 #include "core/layout/layout_io.h"
-#include "core/layout/quad_import.h"
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_io.h"
 #include "tests/fixtures.h"

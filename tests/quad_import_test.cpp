@@ -1,6 +1,6 @@
-// Tests of importing quad-mesh layouts (core/layout/quad_import.h) and of
+// Tests of importing quad-mesh layouts (core/import/quad_import.h) and of
 // `quadsketch-cli import-quads`.
-#include "core/layout/quad_import.h"
+#include "core/import/quad_import.h"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +13,7 @@
 #include <map>
 
 #include "core/base/errors.h"
-#include "core/layout/patch_import.h"
+#include "core/import/patch_import.h"
 #include "core/layout/validate.h"
 #include "core/mesh/closest_point.h"
 #include "core/mesh/mesh_checks.h"

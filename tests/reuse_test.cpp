@@ -11,8 +11,8 @@
 #include <random>
 
 #include "core/field/curvature.h"
+#include "core/import/quad_import.h"
 #include "core/layout/layout_io.h"
-#include "core/layout/quad_import.h"
 #include "core/layout/routing.h"
 #include "core/mesh/mesh_io.h"
 #include "core/nodeopt/optimizer.h"

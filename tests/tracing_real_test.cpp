@@ -7,8 +7,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "core/layout/cage.h"
-#include "core/layout/quad_import.h"
+#include "core/import/cage.h"
+#include "core/import/quad_import.h"
 #include "core/mesh/mesh_io.h"
 #include "core/pipeline/pipeline.h"
 #include "tests/fixtures.h"

@@ -9,7 +9,7 @@
 #include "app/cli/report.h"
 #include "core/base/atomic_file.h"
 #include "core/base/errors.h"
-#include "core/layout/cage.h"
+#include "core/import/cage.h"
 #include "core/layout/layout_io.h"
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_io.h"

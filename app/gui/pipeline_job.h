@@ -15,20 +15,8 @@
 #include "core/extract/tracing.h"
 #include "core/layout/layout.h"
 #include "core/mesh/mesh.h"
+#include "core/pipeline/job_exports.h"
 #include "core/pipeline/worker.h"
-
-namespace qs {
-
-//! What the exporters need, frozen at one step (immutable once published).
-struct JobExports {
-  TriMesh mesh;                                  //!< the job's surface (nodes may have moved it)
-  std::vector<std::array<double, 2>> corner_uv;  //!< parameterization
-  Layout layout;                                 //!< traced output layout
-  Extraction extraction;                         //!< traced arcs
-  std::shared_ptr<const QuadMesh> quads;         //!< null when no quad mesh was built
-};
-
-}  // namespace qs
 
 namespace qs::app {
 

@@ -10,7 +10,6 @@
 
 #include "core/base/atomic_file.h"
 #include "core/base/errors.h"
-#include "core/pipeline/pipeline.h"
 
 namespace qs {
 
@@ -269,15 +268,6 @@ QuadMesh build_quad_mesh(const TriMesh& mesh, const GeometryCache& g, const Layo
     qp.ok = true;
   }
   return out;
-}
-
-QuadMesh build_quad_mesh(const Pipeline& pipeline, const Extraction& extraction,
-                         const QuadMeshOptions& options) {
-  if (!pipeline.field() || !pipeline.parameterization())
-    throw InvalidInputError("quad mesh: the pipeline has no field or parameterization yet");
-  return build_quad_mesh(pipeline.mesh(), pipeline.geometry(), pipeline.layout(),
-                         pipeline.topology(), extraction, pipeline.field()->period_jump,
-                         pipeline.parameterization()->corner_uv, options);
 }
 
 void write_quads_obj(const QuadMesh& qm, const std::string& path, const UvAtlasOptions& atlas) {

@@ -16,8 +16,6 @@
 
 namespace qs {
 
-class Pipeline;
-
 struct QuadMeshOptions {
   //! Target quad edge length q in parameter units (≈ surface length units for an isometric
   //! parameterization). Used when > 0.
@@ -78,11 +76,6 @@ QuadMesh build_quad_mesh(const TriMesh& mesh, const GeometryCache& geometry, con
                          const LayoutTopology& topology, const Extraction& extraction,
                          const std::vector<int>& period_jump,
                          const std::vector<std::array<double, 2>>& corner_uv,
-                         const QuadMeshOptions& options);
-
-//! Same, from a pipeline that has a field, a parameterization and \p extraction (the result of
-//! its last extract()). For the GUI and the CLI. \throw InvalidInputError when a stage is missing.
-QuadMesh build_quad_mesh(const Pipeline& pipeline, const Extraction& extraction,
                          const QuadMeshOptions& options);
 
 //! quads.obj: "v" per vertex, per-corner "vt" with the patch coordinates (s, t) ∈ [0,w]×[0,h]

@@ -6,7 +6,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "core/layout/base_complex.h"
+#include "core/import/base_complex.h"
 #include "core/mesh/mesh.h"
 
 namespace qs {

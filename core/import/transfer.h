@@ -6,7 +6,7 @@
 #include <memory>
 #include <vector>
 
-#include "core/layout/base_complex.h"
+#include "core/import/base_complex.h"
 #include "core/layout/embed.h"
 #include "core/layout/layout.h"
 #include "core/mesh/mesh.h"

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "core/field/curvature.h"
-#include "core/layout/perturb.h"
+#include "core/layout/node_shift.h"
 #include "core/layout/validate.h"
 #include "core/nodeopt/optimizer.h"
 #include "core/nodeopt/optimizer_impl.h"

@@ -12,7 +12,7 @@
 
 #include "core/base/progress.h"
 #include "core/layout/layout.h"
-#include "core/layout/perturb.h"
+#include "core/layout/node_shift.h"
 #include "core/mesh/mesh.h"
 #include "core/nodeopt/gradient.h"
 #include "core/nodeopt/relocation.h"
@@ -59,7 +59,7 @@ struct NodeOptOptions {
   //! fold-overs or falls back to an earlier state (core/nodeopt/retry.h).
   bool keep_nodes_apart = false;
   //! Nodes that already sit next to another node (on its 1-ring, as a displaced sketch puts
-  //! them) are first moved apart (core/layout/perturb.h separate_nodes); the optimization then
+  //! them) are first moved apart (core/layout/node_shift.h separate_nodes); the optimization then
   //! starts from that layout (E_init, the initial fallback). keep_nodes_apart only keeps nodes
   //! from getting there. Off by default (`optimize --separate-nodes`).
   bool separate_crowded_nodes = false;

@@ -239,6 +239,15 @@ Layout Pipeline::output_layout() const {
   return out;
 }
 
+QuadMesh build_quad_mesh(const Pipeline& pipeline, const Extraction& extraction,
+                         const QuadMeshOptions& options) {
+  if (!pipeline.field() || !pipeline.parameterization())
+    throw InvalidInputError("quad mesh: the pipeline has no field or parameterization yet");
+  return build_quad_mesh(pipeline.mesh(), pipeline.geometry(), pipeline.layout(),
+                         pipeline.topology(), extraction, pipeline.field()->period_jump,
+                         pipeline.parameterization()->corner_uv, options);
+}
+
 void write_param_obj(const TriMesh& mesh, const std::vector<std::array<double, 2>>& uv,
                      const std::string& path) {
   write_file_atomic(path, [&](std::ostream& out) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/extract/metrics.h"
+#include "core/extract/quads.h"
 #include "core/extract/tracing.h"
 #include "core/field/cross_field.h"
 #include "core/layout/layout.h"
@@ -151,6 +152,12 @@ class Pipeline {
   //! the owner's thread before a parameterization solver is built.
   void take_vertex_order();
 };
+
+//! The quad mesh (build_quad_mesh, core/extract/quads.h) of a pipeline that has a field, a
+//! parameterization and \p extraction (the result of its last extract()). For the GUI and the
+//! CLI. \throw InvalidInputError when a stage is missing.
+QuadMesh build_quad_mesh(const Pipeline& pipeline, const Extraction& extraction,
+                         const QuadMeshOptions& options);
 
 //! Writes param.obj: the mesh (same vertex and face order) with one texture coordinate per
 //! face corner ("f v/vt"), atomically.

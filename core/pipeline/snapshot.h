@@ -77,8 +77,8 @@ struct FieldView {
   std::string warning;
 };
 
-//! Immutable job data the exporters need (defined by the job that fills it, e.g. the editor's
-//! pipeline job); the worker only passes the pointer along.
+//! Immutable job data the exporters need (core/pipeline/job_exports.h, filled by the job's step
+//! function); the worker only passes the pointer along.
 struct JobExports;
 
 struct Snapshot {

@@ -4,8 +4,8 @@
 #include <fstream>
 #include <iostream>
 
+#include "core/import/perturb.h"
 #include "core/layout/layout_io.h"
-#include "core/layout/perturb.h"
 #include "tests/fixtures.h"
 
 using namespace qs;

@@ -1,14 +1,11 @@
-#include "core/layout/perturb.h"
+#include "core/layout/node_shift.h"
 
 #include <algorithm>
 #include <limits>
-#include <random>
-#include <string>
 
 #include "core/base/errors.h"
 #include "core/layout/path_finder.h"
 #include "core/layout/routing.h"
-#include "core/layout/validate.h"
 
 namespace qs {
 
@@ -17,13 +14,12 @@ namespace {
 using HH = OpenMesh::HalfedgeHandle;
 using VH = OpenMesh::VertexHandle;
 
-// Moves nodes one at a time, keeping incremental ownership maps so that each move costs time
-// proportional to the patches around the node, not to the whole mesh.
-class Perturber {
+}  // namespace
+
+class NodeShifter::Impl {
  public:
-  Perturber(const TriMesh& mesh, const Layout& layout, const PerturbLayoutOptions& options)
-      : mesh_(mesh), options_(options), rng_(options.seed), finder_(mesh) {
-    result_.layout = layout;
+  Impl(const TriMesh& mesh, const Layout& layout) : mesh_(mesh), finder_(mesh) {
+    layout_ = layout;
     const LayoutTopology topo = build_topology(mesh, layout);
     const int nv = static_cast<int>(mesh.n_vertices());
     vertex_node_.assign(nv, -1);
@@ -54,26 +50,12 @@ class Perturber {
       patch_faces_[face_patch_[f]].push_back(static_cast<int>(f));
   }
 
-  PerturbResult run() {
-    Layout& layout = result_.layout;
-    for (size_t n = 0; n < layout.nodes.size(); ++n) {
-      const int id = layout.nodes[n].id;
-      bool pinned = layout.nodes[n].pinned;
-      bool loop = false;
-      for (int a : node_arcs_[n]) {
-        pinned = pinned || layout.arcs[a].pinned;
-        loop = loop || (!layout.arcs[a].dangling() && layout.arcs[a].from == layout.arcs[a].to);
-      }
-      if (pinned) {
-        result_.pinned_nodes.push_back(id);
-      } else if (loop || node_arcs_[n].empty() || !move_node(static_cast<int>(n))) {
-        result_.stuck_nodes.push_back(id);
-      } else {
-        result_.moved_nodes.push_back(id);
-      }
-    }
+  const Layout& layout() const { return layout_; }
+  const std::vector<int>& node_arcs(int n) const { return node_arcs_[n]; }
+
+  Layout take_layout() {
     clear_moved_node_outputs();
-    return std::move(result_);
+    return std::move(layout_);
   }
 
   // Moves every crowded node (another node within options.min_distance − 1 edge rings) that
@@ -81,7 +63,7 @@ class Perturber {
   SeparateNodesResult separate(const std::vector<char>& movable,
                                const SeparateNodesOptions& options) {
     SeparateNodesResult out;
-    Layout& layout = result_.layout;
+    Layout& layout = layout_;
     const int nn = static_cast<int>(layout.nodes.size());
     for (int n = 0; n < nn; ++n)
       if (crowded(n, layout.nodes[n].vertex, options.min_distance))
@@ -107,12 +89,11 @@ class Perturber {
     return out;
   }
 
- private:
   // A moved node's output fields (point, position, valence) describe its old vertex; a stale
   // `point` would contradict `vertex` (load_layout refuses such a node).
   void clear_moved_node_outputs() {
     for (size_t n = 0; n < input_vertex_.size(); ++n) {
-      LayoutNode& node = result_.layout.nodes[n];
+      LayoutNode& node = layout_.nodes[n];
       if (node.vertex == input_vertex_[n]) continue;
       node.point.reset();
       node.position.reset();
@@ -120,9 +101,9 @@ class Perturber {
     }
   }
 
-  // Not pinned, no pinned arc, no loop arc, at least one arc: the nodes perturb may move.
+  // Not pinned, no pinned arc, no loop arc, at least one arc.
   bool may_move(int n) const {
-    const Layout& layout = result_.layout;
+    const Layout& layout = layout_;
     if (layout.nodes[n].pinned || node_arcs_[n].empty()) return false;
     for (int a : node_arcs_[n]) {
       const LayoutArc& arc = layout.arcs[a];
@@ -162,9 +143,8 @@ class Perturber {
   }
 
   bool separate_node(int n, const SeparateNodesOptions& options) {
-    const Layout& layout = result_.layout;
+    const Layout& layout = layout_;
     const int v0 = layout.nodes[n].vertex;
-    const bool boundary = mesh_.is_boundary(VH(v0));
     auto point = [&](int v) { return mesh_.point(VH(v)); };
     // The nodes crowding n: the candidates farthest from them are tried first within a ring.
     std::vector<Vec3> crowders;
@@ -176,13 +156,7 @@ class Perturber {
     };
     std::vector<Candidate> candidates;
     for (int r = 1; r <= options.search_rings; ++r) {
-      std::vector<int> ring = ring_vertices_at(v0, r);
-      mark_reachable(n, v0, 2 * r + 2);
-      std::vector<int> reachable;
-      for (int v : ring)
-        if (stamp_[v] == current_stamp_) reachable.push_back(v);
-      for (int v : reachable) {
-        if (mesh_.is_boundary(VH(v)) != boundary) continue;
+      for (int v : ring_candidates(n, r)) {
         if (vertex_node_[v] >= 0 || crowded(n, v, options.min_distance)) continue;
         double clearance = std::numeric_limits<double>::infinity();
         for (const Vec3& c : crowders) clearance = std::min(clearance, (point(v) - c).norm());
@@ -226,7 +200,7 @@ class Perturber {
   }
 
   void mark_arc(int a) {
-    const auto& p = result_.layout.arcs[a].path;
+    const auto& p = layout_.arcs[a].path;
     for (size_t k = 0; k < p.size(); ++k) {
       if (vertex_node_[p[k]] < 0) {
         vertex_arc_[p[k]] = a;
@@ -240,7 +214,7 @@ class Perturber {
   }
 
   void unmark_arc(int a) {
-    const auto& p = result_.layout.arcs[a].path;
+    const auto& p = layout_.arcs[a].path;
     for (size_t k = 0; k < p.size(); ++k) {
       if (vertex_node_[p[k]] < 0) {
         vertex_arc_[p[k]] = -1;
@@ -254,17 +228,13 @@ class Perturber {
   }
 
   void set_node_vertex(int n, int v) {
-    const int old = result_.layout.nodes[n].vertex;
+    const int old = layout_.nodes[n].vertex;
     vertex_node_[old] = -1;
     obstacles_.vertex_blocked[old] = 0;
-    result_.layout.nodes[n].vertex = v;
+    layout_.nodes[n].vertex = v;
     vertex_node_[v] = n;
     obstacles_.vertex_blocked[v] = 1;
   }
-
-  // ---- candidates ----
-  // Vertices at exactly `rings` BFS steps from v0 on the whole mesh.
-  std::vector<int> ring_vertices(int v0) { return ring_vertices_at(v0, options_.rings); }
 
   // Stamps the vertices reachable from v0 within `depth` steps without entering another node
   // or another arc (the node's own arcs, about to be re-routed, do not count).
@@ -292,36 +262,24 @@ class Perturber {
     }
   }
 
-  bool move_node(int n) {
-    Layout& layout = result_.layout;
-    const int v0 = layout.nodes[n].vertex;
+  std::vector<int> ring_candidates(int n, int rings) {
+    const int v0 = layout_.nodes[n].vertex;
     const bool boundary = mesh_.is_boundary(VH(v0));
-    const std::vector<int> ring = ring_vertices(v0);
+    const std::vector<int> ring = ring_vertices_at(v0, rings);
     // A ring vertex beyond another arc would put the node into a foreign patch.
-    mark_reachable(n, v0, 2 * options_.rings + 2);
+    mark_reachable(n, v0, 2 * rings + 2);
     std::vector<int> candidates;
     for (int v : ring) {
       if (stamp_[v] != current_stamp_) continue;
       if (mesh_.is_boundary(VH(v)) != boundary) continue;
       candidates.push_back(v);
     }
-    std::sort(candidates.begin(), candidates.end());
-    // Fisher–Yates with our own index draws: std::shuffle's use of the engine is not specified,
-    // and the same seed must give the same result everywhere.
-    for (size_t i = candidates.size(); i > 1; --i) {
-      const size_t j = rng_() % i;
-      std::swap(candidates[i - 1], candidates[j]);
-    }
-    const int attempts = std::min<int>(options_.max_attempts, static_cast<int>(candidates.size()));
-    for (int k = 0; k < attempts; ++k) {
-      if (try_move(n, candidates[k])) return true;
-    }
-    return false;
+    return candidates;
   }
 
   // ---- one move ----
   bool try_move(int n, int target_vertex) {
-    Layout& layout = result_.layout;
+    Layout& layout = layout_;
     const int v0 = layout.nodes[n].vertex;
     // The node's patches: every face around it, and their patches.
     std::vector<int> patches;
@@ -389,7 +347,7 @@ class Perturber {
 
   // Half-arcs around node n's vertex, counter-clockwise.
   std::vector<int> order_at(int n) const {
-    const Layout& layout = result_.layout;
+    const Layout& layout = layout_;
     const VH v(layout.nodes[n].vertex);
     std::vector<int> order;
     // Start anywhere: orders are compared up to rotation.
@@ -405,7 +363,7 @@ class Perturber {
   }
 
   bool orders_kept(int n, const std::vector<int>& arcs) const {
-    const Layout& layout = result_.layout;
+    const Layout& layout = layout_;
     if (!same_cycle(reference_order_[n], order_at(n))) return false;
     for (int a : arcs) {
       for (int id : {layout.arcs[a].from, layout.arcs[a].to}) {
@@ -474,11 +432,10 @@ class Perturber {
     }
   }
 
+ private:
   const TriMesh& mesh_;
-  const PerturbLayoutOptions& options_;
-  std::mt19937 rng_;
   PathFinder finder_;
-  PerturbResult result_;
+  Layout layout_;
   std::vector<int> input_vertex_;  // per node, its vertex in the input layout
   std::vector<int> vertex_node_, vertex_arc_, edge_arc_;
   RoutingObstacles obstacles_;
@@ -492,7 +449,39 @@ class Perturber {
   std::vector<std::vector<int>> components_;
 };
 
-}  // namespace
+NodeShifter::NodeShifter(const TriMesh& mesh, const Layout& layout)
+    : impl_(std::make_unique<Impl>(mesh, layout)) {}
+
+NodeShifter::~NodeShifter() = default;
+
+const Layout& NodeShifter::layout() const {
+  return impl_->layout();
+}
+
+const std::vector<int>& NodeShifter::node_arcs(int n) const {
+  return impl_->node_arcs(n);
+}
+
+bool NodeShifter::may_move(int n) const {
+  return impl_->may_move(n);
+}
+
+std::vector<int> NodeShifter::ring_candidates(int n, int rings) {
+  return impl_->ring_candidates(n, rings);
+}
+
+bool NodeShifter::try_move(int n, int vertex) {
+  return impl_->try_move(n, vertex);
+}
+
+SeparateNodesResult NodeShifter::separate(const std::vector<char>& movable,
+                                          const SeparateNodesOptions& options) {
+  return impl_->separate(movable, options);
+}
+
+Layout NodeShifter::take_layout() {
+  return impl_->take_layout();
+}
 
 SeparateNodesResult separate_nodes(const TriMesh& mesh, const Layout& layout,
                                    const std::vector<char>& movable,
@@ -501,38 +490,7 @@ SeparateNodesResult separate_nodes(const TriMesh& mesh, const Layout& layout,
     throw InvalidInputError("separate_nodes: min_distance and search_rings must be at least 1");
   if (!movable.empty() && movable.size() != layout.nodes.size())
     throw InvalidInputError("separate_nodes: one movable flag per layout node expected");
-  PerturbLayoutOptions perturb;
-  perturb.rings = options.search_rings;
-  perturb.max_attempts = options.max_attempts;
-  return Perturber(mesh, layout, perturb).separate(movable, options);
-}
-
-PerturbResult perturb_layout(const TriMesh& mesh, const Layout& layout,
-                             const PerturbLayoutOptions& options) {
-  if (options.rings < 1) {
-    throw InvalidInputError("rings must be at least 1 (got " + std::to_string(options.rings) + ")");
-  }
-  const ValidationResult before = validate_layout(mesh, layout);
-  if (!before.valid()) {
-    std::string msg =
-        "cannot perturb an invalid layout (" + std::to_string(before.errors()) + " error(s)):";
-    int shown = 0;
-    for (const auto& issue : before.issues) {
-      if (issue.severity != IssueSeverity::Error) continue;
-      if (++shown > 12) break;
-      msg += "\n  " + format_issue(issue);
-    }
-    throw InvalidInputError(msg);
-  }
-  PerturbResult result = Perturber(mesh, layout, options).run();
-  const ValidationResult after = validate_layout(mesh, result.layout);
-  if (!after.valid()) {
-    std::string msg = "perturb produced an invalid layout (internal error):";
-    for (const auto& issue : after.issues)
-      if (issue.severity == IssueSeverity::Error) msg += "\n  " + format_issue(issue);
-    throw QsError(msg);
-  }
-  return result;
+  return NodeShifter(mesh, layout).separate(movable, options);
 }
 
 }  // namespace qs

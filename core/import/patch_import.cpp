@@ -1,4 +1,4 @@
-#include "core/layout/patch_import.h"
+#include "core/import/patch_import.h"
 
 #include <algorithm>
 #include <cmath>

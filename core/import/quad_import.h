@@ -8,10 +8,11 @@
 #include <string>
 #include <vector>
 
+#include "core/import/base_complex.h"
+#include "core/import/coarsen.h"
+#include "core/import/quad_triangulation.h"
 #include "core/import/transfer.h"
-#include "core/layout/base_complex.h"
 #include "core/layout/layout.h"
-#include "core/layout/quad_triangulation.h"
 #include "core/mesh/mesh.h"
 
 namespace qs {

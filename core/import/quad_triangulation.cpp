@@ -1,4 +1,4 @@
-#include "core/layout/quad_triangulation.h"
+#include "core/import/quad_triangulation.h"
 
 #include <string>
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/layout/layout.h"
+#include "core/layout/node_shift.h"
 #include "core/mesh/mesh.h"
 
 namespace qs {
@@ -40,37 +41,5 @@ struct PerturbResult {
 //! \throw InvalidInputError if the layout is invalid (listing its errors) or rings < 1.
 PerturbResult perturb_layout(const TriMesh& mesh, const Layout& layout,
                              const PerturbLayoutOptions& options);
-
-struct SeparateNodesOptions {
-  //! A node is crowded when another node is fewer than this many mesh edges away (2: on its
-  //! vertex's 1-ring, the nodes then share a triangle edge).
-  int min_distance = 2;
-  int search_rings = 2;   //!< a crowded node moves at most this many edge rings
-  int max_attempts = 12;  //!< candidate vertices tried per node (nearest rings first)
-  int rounds = 2;         //!< passes over the crowded nodes (a move can free another's way)
-};
-
-struct SeparateNodesResult {
-  //! The layout with crowded nodes moved (same ids, order; moved nodes lose their output
-  //! fields like in PerturbResult).
-  Layout layout;
-  std::vector<int> crowded_nodes;  //!< ids of the nodes crowded in the input
-  std::vector<int> moved_nodes;    //!< ids of the nodes moved
-  std::vector<int> still_crowded;  //!< ids of the nodes crowded in the result
-};
-
-//! Moves nodes apart that sit closer than options.min_distance edges to another node (node
-//! optimization with nodes kept apart, NodeOptOptions::keep_nodes_apart: a displaced layout
-//! can put two nodes on one triangle, where the orientation constraints cannot unfold the
-//! patches between them). Each crowded node that \p movable allows (one flag per layout node;
-//! empty: all) and that perturb_layout could move (not pinned, no pinned or loop arc) goes to
-//! the nearest vertex (fewest edge rings, then farthest from the nodes crowding it) where no
-//! other node is closer than min_distance, under perturb_layout's rules: in its own patches,
-//! on the boundary exactly when it was, its arcs re-routed by shortest paths keeping every
-//! cyclic order and patch. A node that no candidate fits stays (still_crowded).
-//! \pre \p layout is valid on \p mesh. \throw InvalidInputError for bad options or flags.
-SeparateNodesResult separate_nodes(const TriMesh& mesh, const Layout& layout,
-                                   const std::vector<char>& movable,
-                                   const SeparateNodesOptions& options = {});
 
 }  // namespace qs

@@ -1,4 +1,4 @@
-#include "core/layout/quad_import.h"
+#include "core/import/quad_import.h"
 
 #include <algorithm>
 #include <cmath>

@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "core/layout/base_complex.h"
+#include "core/import/base_complex.h"
 #include "core/layout/layout.h"
 #include "core/mesh/mesh.h"
 
