@@ -23,6 +23,7 @@
 #include "core/layout/validate.h"
 #include "core/mesh/mesh_io.h"
 #include "core/nodeopt/symmetric_step.h"
+#include "tests/fixtures.h"
 #include "tests/scoped_env.h"
 #ifdef QS_TEST_RENDER
 #include "render/guide_layer.h"
@@ -327,7 +328,11 @@ TEST_F(GuiSketch, MirroredEdgeLoopKeepsTheLayoutSymmetric) {
   ASSERT_GE(arc, 0);
   editor.insert_edge_loop(arc);
   editor.poll();
-  EXPECT_GT(editor.doc.editor.layout().nodes.size(), layout.nodes.size()) << editor.status();
+  // Every chord of the cube is its own mirror image about x = 0: one loop of 4 nodes, and the
+  // status does not claim a mirror loop.
+  EXPECT_EQ(editor.doc.editor.layout().nodes.size(), layout.nodes.size() + 4) << editor.status();
+  EXPECT_NE(editor.status().find("Edge loop inserted"), std::string::npos) << editor.status();
+  EXPECT_EQ(editor.status().find("mirror"), std::string::npos) << editor.status();
   EXPECT_TRUE(editor.doc.validation.valid());
   const SymmetryPairs after =
       match_mirror_pairs(mesh_of(editor), editor.doc.editor.layout(), editor.mirror()->plane);
@@ -434,6 +439,47 @@ TEST_F(GuiSketch, FieldHintsAreComputedInTheBackgroundOncePerMesh) {
   editor.poll();
   EXPECT_EQ(editor.field_hints.field(), nullptr);
   ASSERT_TRUE(poll_until(editor, [&] { return editor.field_hints.field() != nullptr; }));
+}
+
+// The hint scale hides pairs of opposite singularities closer than the scale: on a bumpy
+// rounded cube, a scale of 0 shows every singularity of the field, the default fewer, with the
+// same index sum; a change shows after the next poll without a new field computation.
+TEST_F(GuiSketch, HintScaleHidesClosePairs) {
+  auto bumpy = test::cube_sphere(24, Vec3(1, 1, 1), /*project=*/false);
+  for (const auto vh : bumpy.mesh.vertices()) {
+    const Vec3 p = bumpy.mesh.point(vh);
+    Vec3 q = p;
+    q.normalize();
+    const double bump = 0.015 * std::sin(23.0 * p[0] + 1.0) * std::sin(19.0 * p[1] + 2.0) *
+                        std::sin(17.0 * p[2] + 3.0);
+    bumpy.mesh.set_point(vh, (0.3 * p + 0.7 * std::sqrt(3.0) * q) * (1.0 + bump));
+  }
+  const fs::path path = dir_ / "bumpy_cube.obj";
+  save_mesh_obj(bumpy.mesh, path.string());
+  Editor editor(config());
+  ASSERT_TRUE(editor.start(path.string(), ""));
+  editor.field_hints.enabled = true;
+  ASSERT_TRUE(poll_until(editor, [&] { return editor.field_hints.field() != nullptr; }));
+  const auto sum = [](const NaturalField& f) {
+    int total = 0;
+    for (const auto& s : f.singularities) total += s.index;
+    return total;
+  };
+  const std::size_t all = editor.field_hints.raw_field()->singularities.size();
+  const std::size_t shown = editor.field_hints.field()->singularities.size();
+  EXPECT_LT(shown, all);
+  EXPECT_EQ(sum(*editor.field_hints.field()), 8);
+  editor.field_hints.set_scale(0.0);
+  const std::uint64_t version = editor.field_hints.version();
+  ASSERT_TRUE(
+      poll_until(editor, [&] { return editor.field_hints.field()->singularities.size() == all; }));
+  EXPECT_GT(editor.field_hints.version(), version);
+  EXPECT_FALSE(editor.field_hints.computing());  // the field itself is not computed again
+  editor.field_hints.set_scale(std::nan(""));    // not a number: the default
+  ASSERT_TRUE(poll_until(
+      editor, [&] { return editor.field_hints.field()->singularities.size() == shown; }));
+  editor.field_hints.set_scale(7.0);  // clamped
+  EXPECT_EQ(editor.field_hints.scale(), FieldHints::kMaxScale);
 }
 
 TEST_F(GuiSketch, FittedPlaneOfTheExampleHasNoResidual) {

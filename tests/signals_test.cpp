@@ -76,6 +76,19 @@ pid_t spawn_cli(const std::vector<std::string>& args, const std::string& log) {
   return rc == 0 ? pid : -1;
 }
 
+//! Whether process \p pid has installed a handler for \p signo (Linux: the SigCgt mask of
+//! /proc/<pid>/status). Before that, the signal takes its default action: the process dies
+//! without touching its output folder, which is the kernel's doing, not the CLI's.
+bool catches_signal(pid_t pid, int signo) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(in, line);) {
+    if (!line.starts_with("SigCgt:")) continue;
+    const unsigned long long mask = std::stoull(line.substr(7), nullptr, 16);
+    return ((mask >> (signo - 1)) & 1ULL) != 0;
+  }
+  return false;
+}
+
 //! Waits for \p pid up to \p timeout; returns the exit code, 128 + signal when it was killed
 //! by a signal, or -1 on a timeout (the process is then killed).
 int wait_exit(pid_t pid, std::chrono::seconds timeout) {
@@ -150,8 +163,13 @@ RunOutcome run_and_signal(const std::string& out, int signo, std::chrono::millis
   EXPECT_GT(pid, 0);
   RunOutcome r;
   if (pid <= 0) return r;
-  // Count the delay from the moment the run has started working (it creates its output
-  // folder first), not from the spawn: on a loaded machine start-up alone can take a second.
+  // Count the delay from the moment the run has started working, not from the spawn: on a
+  // loaded machine start-up alone (loading the shared libraries) can take a second. The run
+  // catches the signal first thing in main(), then creates its output folder (a rerun finds
+  // it there already).
+  for (int i = 0; i < 6000 && !catches_signal(pid, signo); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  EXPECT_TRUE(catches_signal(pid, signo)) << "the CLI never installed its signal handler";
   for (int i = 0; i < 6000 && !std::filesystem::exists(out); ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   std::this_thread::sleep_for(delay);

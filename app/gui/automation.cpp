@@ -273,6 +273,13 @@ bool Automation::run_command(const Command& c, AppContext& ctx, const glm::ivec2
       fail(c, "expected: field_hints on|off");
     else
       editor.field_hints.enabled = a[0] == "on";
+  } else if (n == "hint_scale") {
+    double fraction = -1.0;
+    if (a.size() != 1 || !parse_double(a[0], fraction) || !(fraction >= 0.0) ||
+        fraction > FieldHints::kMaxScale)
+      fail(c, "expected: hint_scale F (a fraction of the diagonal in [0, 0.5])");
+    else
+      editor.field_hints.set_scale(fraction);
   } else if (n == "wireframe") {
     if (a.empty() || (a[0] != "on" && a[0] != "off"))
       fail(c, "expected: wireframe on|off");

@@ -18,6 +18,7 @@
 //                            dangling | insert_loop | remove_loop
 //   symmetry off|x|y|z|auto  mirrored sketching off, or on about that plane (Sketch panel)
 //   field_hints on|off       the View panel's "Field hints"
+//   hint_scale F             the View panel's "Hint scale", F a fraction of the diagonal
 //   wireframe on|off         the View panel's wireframe of the surface
 //   wait_guides [S]          until the mirror plane and the field hints that are on are ready
 //                            (fails at once without a mesh or when their computation failed)

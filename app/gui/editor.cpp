@@ -435,16 +435,18 @@ void Editor::apply(const EditResult& result, const std::string& done_message) {
 }
 
 void Editor::insert_edge_loop(int arc_id) {
-  const EditResult r = sketch_insert_edge_loop(doc.editor, mirror(), arc_id);
+  bool mirror_loop = false;
+  const EditResult r = sketch_insert_edge_loop(doc.editor, mirror(), arc_id, &mirror_loop);
   apply(r, "Edge loop inserted through the chord crossing arc " + std::to_string(arc_id) +
-               (mirror() ? " (and its mirror)" : ""));
+               (mirror_loop ? " (and its mirror)" : ""));
   if (r) selection = {r.id, -1};
 }
 
 void Editor::remove_edge_loop(int arc_id) {
-  const EditResult r = sketch_remove_edge_loop(doc.editor, mirror(), arc_id);
+  bool mirror_loop = false;
+  const EditResult r = sketch_remove_edge_loop(doc.editor, mirror(), arc_id, &mirror_loop);
   apply(r, "Edge loop through arc " + std::to_string(arc_id) + " removed" +
-               (mirror() ? " (and its mirror)" : ""));
+               (mirror_loop ? " (and its mirror)" : ""));
   if (r) selection = {};
 }
 

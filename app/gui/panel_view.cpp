@@ -116,7 +116,24 @@ void draw_field_hints(AppContext& ctx) {
     color_swatch("valence 5", render::GuideColors::singularity(-1));
     ImGui::SameLine();
     text(std::to_string(five) + (other > 0 ? " (+" + std::to_string(other) + " other)" : ""));
+    const std::size_t hidden =
+        hints.raw_field()->singularities.size() - hints.field()->singularities.size();
+    if (hidden > 0) {
+      ImGui::SameLine();
+      text_colored(kDimColor, std::to_string(hidden / 2) + " close pairs hidden");
+    }
   }
+  // Applied when the slider is released: each change recomputes the pairing.
+  float percent = static_cast<float>(hints.scale() * 100.0);
+  ImGui::SetNextItemWidth(ImGui::GetFontSize() * 10);
+  ImGui::SliderFloat("Hint scale", &percent, 0.0f, static_cast<float>(FieldHints::kMaxScale * 100),
+                     "%.1f %% of the size");
+  if (ImGui::IsItemDeactivatedAfterEdit()) hints.set_scale(percent / 100.0);
+  tooltip(
+      "About the size of the patches you intend. A singularity and one of opposite index closer "
+      "than this (along the surface, as a percentage of the model's bounding-box diagonal) "
+      "cancel: a layout with patches of that size needs no irregular nodes for them. 0 shows "
+      "every singularity of the field.");
 }
 
 }  // namespace

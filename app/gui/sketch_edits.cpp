@@ -472,7 +472,9 @@ EditResult insert_loop(LayoutEditor& editor, int arc_id, std::vector<int>* chord
 
 }  // namespace
 
-EditResult sketch_insert_edge_loop(LayoutEditor& editor, const Mirror* m, int arc_id) {
+EditResult sketch_insert_edge_loop(LayoutEditor& editor, const Mirror* m, int arc_id,
+                                   bool* mirror_loop) {
+  if (mirror_loop) *mirror_loop = false;
   const TriMesh* mesh = editor.mesh();
   if (!mesh) return EditResult::fail("no mesh loaded");
   if (!m) return insert_loop(editor, arc_id, nullptr);
@@ -482,11 +484,14 @@ EditResult sketch_insert_edge_loop(LayoutEditor& editor, const Mirror* m, int ar
     const EditResult r = insert_loop(editor, arc_id, &chord);
     if (!r || mid < 0 || std::find(chord.begin(), chord.end(), mid) != chord.end()) return r;
     const EditResult second = insert_loop(editor, mid, nullptr);
+    if (mirror_loop) *mirror_loop = second.ok;
     return second ? r : second;
   });
 }
 
-EditResult sketch_remove_edge_loop(LayoutEditor& editor, const Mirror* m, int arc_id) {
+EditResult sketch_remove_edge_loop(LayoutEditor& editor, const Mirror* m, int arc_id,
+                                   bool* mirror_loop) {
+  if (mirror_loop) *mirror_loop = false;
   const TriMesh* mesh = editor.mesh();
   if (!mesh) return EditResult::fail("no mesh loaded");
   auto remove = [&](int id) {
@@ -519,6 +524,7 @@ EditResult sketch_remove_edge_loop(LayoutEditor& editor, const Mirror* m, int ar
     if (!r || mid < 0 || std::find(loop_ids.begin(), loop_ids.end(), mid) != loop_ids.end())
       return r;
     const EditResult second = remove(mid);
+    if (mirror_loop) *mirror_loop = second.ok;
     return second ? r : second;
   });
 }

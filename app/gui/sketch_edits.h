@@ -66,11 +66,14 @@ std::string follow_mirror(const TriMesh& mesh, const Mirror& mirror, const Layou
 //! Inserts an edge loop through the poly-chord crossing arc \p arc_id (insert_edge_loop, routed
 //! on the mesh with route_layout; the new nodes keep only their vertex) and, with a mirror, the
 //! mirror loop when the mirror arc lies on another chord. EditResult::id: the first new node.
-//! Refused with the reason (no chord, a patch that is not 4-sided, an arc of one edge, a route
-//! that fails, a result that is not valid).
-EditResult sketch_insert_edge_loop(LayoutEditor& editor, const Mirror* mirror, int arc_id);
+//! \p mirror_loop (optional) is set to whether a second, mirror loop was inserted (false when
+//! the loop is its own mirror image). Refused with the reason (no chord, a patch that is not
+//! 4-sided, an arc of one edge, a route that fails, a result that is not valid).
+EditResult sketch_insert_edge_loop(LayoutEditor& editor, const Mirror* mirror, int arc_id,
+                                   bool* mirror_loop = nullptr);
 //! Removes the edge loop through arc \p arc_id (remove_edge_loop) and, with a mirror, the
-//! mirror loop when it is another one.
-EditResult sketch_remove_edge_loop(LayoutEditor& editor, const Mirror* mirror, int arc_id);
+//! mirror loop when it is another one; \p mirror_loop (optional) tells whether it was.
+EditResult sketch_remove_edge_loop(LayoutEditor& editor, const Mirror* mirror, int arc_id,
+                                   bool* mirror_loop = nullptr);
 
 }  // namespace qs::app

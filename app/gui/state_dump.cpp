@@ -103,7 +103,10 @@ json state_json(AppContext& ctx, int frames) {
   state["symmetry"] = symmetry;
   json hints = {{"enabled", editor.field_hints.enabled},
                 {"computing", editor.field_hints.computing()},
-                {"error", editor.field_hints.error()}};
+                {"error", editor.field_hints.error()},
+                {"scale", editor.field_hints.scale()}};
+  if (const NaturalField* raw = editor.field_hints.raw_field())
+    hints["all_singularities"] = raw->singularities.size();
   if (const NaturalField* f = editor.field_hints.field()) {
     json singularities = json::array();
     for (const auto& s : f->singularities)

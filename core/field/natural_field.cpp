@@ -1,8 +1,13 @@
 #include "core/field/natural_field.h"
 
 #include <Eigen/Sparse>
+#include <algorithm>
 #include <cmath>
+#include <functional>
+#include <queue>
 #include <string>
+#include <tuple>
+#include <utility>
 
 #include "core/base/errors.h"
 #include "core/base/spd_solver.h"
@@ -117,6 +122,73 @@ NaturalField compute_natural_field(const TriMesh& mesh, const GeometryCache& g,
   for (int v = 0; v < g.n_vertices; ++v)
     if (out.quarter_index[v] != 0) out.singularities.push_back({v, out.quarter_index[v]});
   return out;
+}
+
+std::vector<FieldSingularity> cancel_close_pairs(const TriMesh& mesh,
+                                                 const std::vector<FieldSingularity>& singularities,
+                                                 double radius) {
+  if (!std::isfinite(radius))
+    throw InvalidInputError("singularity pairing radius must be a finite number");
+  const int nv = static_cast<int>(mesh.n_vertices());
+  std::vector<int> at_vertex(nv, -1);  // singularity index per vertex, -1 for none
+  for (std::size_t k = 0; k < singularities.size(); ++k) {
+    const int v = singularities[k].vertex;
+    if (v < 0 || v >= nv)
+      throw InvalidInputError("singularity at vertex " + std::to_string(v) +
+                              " is not a vertex of the mesh (" + std::to_string(nv) + " vertices)");
+    at_vertex[v] = static_cast<int>(k);
+  }
+  if (!(radius > 0.0) || singularities.size() < 2) return singularities;
+
+  // Candidate pairs (distance, k, l) with k < l and opposite indices, from a Dijkstra ball of
+  // the radius around every singularity; the work arrays are reset through `touched`.
+  std::vector<std::tuple<double, int, int>> pairs;
+  std::vector<double> dist(nv, radius);
+  std::vector<int> touched;
+  using Item = std::pair<double, int>;
+  for (std::size_t k = 0; k < singularities.size(); ++k) {
+    const int source = singularities[k].vertex;
+    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+    dist[source] = 0.0;
+    touched.push_back(source);
+    queue.emplace(0.0, source);
+    while (!queue.empty()) {
+      const auto [d, v] = queue.top();
+      queue.pop();
+      if (d > dist[v]) continue;
+      const int l = at_vertex[v];
+      if (l > static_cast<int>(k) && singularities[l].index == -singularities[k].index)
+        pairs.emplace_back(d, static_cast<int>(k), l);
+      const auto vh = OpenMesh::VertexHandle(v);
+      for (const auto w : mesh.vv_range(vh)) {
+        const double nd = d + (mesh.point(w) - mesh.point(vh)).norm();
+        if (nd < dist[w.idx()]) {
+          if (dist[w.idx()] == radius) touched.push_back(w.idx());
+          dist[w.idx()] = nd;
+          queue.emplace(nd, w.idx());
+        }
+      }
+    }
+    for (int v : touched) dist[v] = radius;
+    touched.clear();
+  }
+  std::sort(pairs.begin(), pairs.end(), [&](const auto& a, const auto& b) {
+    const auto key = [&](const auto& p) {
+      const int va = singularities[std::get<1>(p)].vertex,
+                vb = singularities[std::get<2>(p)].vertex;
+      return std::make_tuple(std::get<0>(p), std::min(va, vb), std::max(va, vb));
+    };
+    return key(a) < key(b);
+  });
+  std::vector<char> cancelled(singularities.size(), 0);
+  for (const auto& [d, k, l] : pairs) {
+    if (cancelled[k] || cancelled[l]) continue;
+    cancelled[k] = cancelled[l] = 1;
+  }
+  std::vector<FieldSingularity> kept;
+  for (std::size_t k = 0; k < singularities.size(); ++k)
+    if (!cancelled[k]) kept.push_back(singularities[k]);
+  return kept;
 }
 
 }  // namespace qs

@@ -57,6 +57,18 @@ struct NaturalField {
   FieldConstraints constraints;                 //!< the direction constraints used
 };
 
+//! The singularities of \p singularities that remain at the length scale \p radius (model
+//! units): pairs of opposite index (a and −a) whose vertices are closer than \p radius along
+//! mesh edges cancel, the closest pair first (ties: the lower vertex indices first). A quad
+//! layout whose patches are larger than \p radius cannot resolve such a pair, so it places no
+//! irregular nodes there. The rest keep their order; the index sum is unchanged.
+//! \p radius ≤ 0 keeps all. Deterministic; costs one Dijkstra ball of \p radius per
+//! singularity.
+//! \throw InvalidInputError when \p radius is not finite or a vertex is out of range.
+std::vector<FieldSingularity> cancel_close_pairs(const TriMesh& mesh,
+                                                 const std::vector<FieldSingularity>& singularities,
+                                                 double radius);
+
 //! The natural cross field of \p mesh (\p geometry: build_geometry of it).
 //! \throw InvalidInputError for invalid options, SolverError when the solve fails.
 NaturalField compute_natural_field(const TriMesh& mesh, const GeometryCache& geometry,
