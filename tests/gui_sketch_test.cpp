@@ -115,6 +115,7 @@ std::vector<int> ring_vertices(const TriMesh& mesh, int v, int rings) {
 void expect_symmetric(const Editor& editor) {
   SymmetryPairOptions options;
   options.tolerance = 1e-6;
+  options.edge_lengths = 0.0;
   const SymmetryPairs pairs = match_mirror_pairs(mesh_of(editor), editor.doc.editor.layout(),
                                                  editor.mirror()->plane, options);
   EXPECT_TRUE(pairs.symmetric()) << pairs.problem;
@@ -382,6 +383,7 @@ TEST_F(GuiSketch, RunKeepsAMirroredSketchSymmetric) {
   const Layout sketch = e.layout();
   SymmetryPairOptions exact;
   exact.tolerance = 1e-6;
+  exact.edge_lengths = 0.0;
   const NodeSymmetry pairs{m.plane, match_mirror_pairs(mesh, sketch, m.plane, exact).node_mirror};
 
   editor.job.options.publish_interval_ms = 0;

@@ -74,6 +74,7 @@ TEST(SymmetricOptimize, MirrorPairsEndAsMirrorImagesAndPlaneNodesInThePlane) {
   ASSERT_TRUE(validate_layout(mesh, layout).valid());
   SymmetryPairOptions exact;
   exact.tolerance = 1e-9;
+  exact.edge_lengths = 0.0;
   const SymmetryPairs start = match_mirror_pairs(mesh, layout, plane, exact);
   ASSERT_TRUE(start.symmetric()) << start.problem;
 
@@ -144,7 +145,7 @@ TEST(SymmetricOptimize, AnAsymmetricLayoutIsRefusedNamingItsFirstUnpairedNode) {
   } catch (const InvalidInputError& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find("not mirror symmetric"), std::string::npos) << what;
-    EXPECT_NE(what.find("node 0 (vertex 39)"), std::string::npos) << what;
+    EXPECT_NE(what.find("node 1 (vertex 758)"), std::string::npos) << what;
   }
 }
 

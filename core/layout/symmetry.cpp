@@ -544,8 +544,16 @@ SymmetryPairs match_mirror_pairs(const TriMesh& mesh, const Layout& layout,
                                  const MirrorPlane& plane, const SymmetryPairOptions& options) {
   if (!(options.tolerance > 0.0 && options.tolerance <= 1.0))
     throw InvalidInputError("symmetry tolerance must be in (0, 1], got " + fmt(options.tolerance));
+  if (!(options.edge_lengths >= 0.0) || !std::isfinite(options.edge_lengths))
+    throw InvalidInputError("symmetry edge_lengths must be a finite number >= 0, got " +
+                            fmt(options.edge_lengths));
   const double diagonal = std::max(bounding_box(mesh).diagonal(), 1e-300);
-  const double tol = options.tolerance * diagonal;
+  double mean_edge = 0.0;
+  if (options.edge_lengths > 0.0 && mesh.n_edges() > 0) {
+    for (const auto eh : mesh.edges()) mean_edge += mesh.calc_edge_length(eh);
+    mean_edge /= double(mesh.n_edges());
+  }
+  const double tol = std::max(options.tolerance * diagonal, options.edge_lengths * mean_edge);
   const int nn = int(layout.nodes.size());
   const int na = int(layout.arcs.size());
   SymmetryPairs pairs;
@@ -575,7 +583,7 @@ SymmetryPairs match_mirror_pairs(const TriMesh& mesh, const Layout& layout,
         const LayoutNode& node = layout.nodes[i];
         std::string why = "node " + std::to_string(node.id) + " (vertex " +
                           std::to_string(node.vertex) + ") has no mirror node within " +
-                          fmt(options.tolerance) + " of the bounding-box diagonal";
+                          fmt(tol / diagonal) + " of the bounding-box diagonal";
         if (j >= 0 && nearest_d[i] > tol)
           why += " (the nearest to its mirror image, node " + std::to_string(layout.nodes[j].id) +
                  ", is " + fmt(nearest_d[i] / diagonal) + " of the diagonal away)";

@@ -121,10 +121,14 @@ std::vector<int> mirror_path(const TriMesh& mesh, const ClosestPointTree& tree,
                              const RoutingObstacles& obstacles, int first = -1, int last = -1);
 
 struct SymmetryPairOptions {
-  //! Nodes pair when the reflection of one lies within this fraction of the bounding-box
-  //! diagonal of the other; arcs when every reflected vertex of one lies within it of the
-  //! other's polyline. In (0, 1].
+  //! Nodes pair when the reflection of one lies within the tolerance of the other; arcs when
+  //! every reflected vertex of one lies within it of the other's polyline. The tolerance is
+  //! the larger of `tolerance` × the bounding-box diagonal and `edge_lengths` × the mean edge
+  //! length: a node on a vertex can be no closer to its mirror image than the tessellation
+  //! allows (the editor's mirrored sketching pairs within 1.5 mean edges). `tolerance` in
+  //! (0, 1], `edge_lengths` ≥ 0 (0: the diagonal's fraction alone).
   double tolerance = 1e-2;
+  double edge_lengths = 1.5;
 };
 
 //! Mirror pairs of a layout's nodes and arcs. Node positions are their vertices' (their `point`
