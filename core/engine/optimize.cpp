@@ -162,7 +162,7 @@ struct OptimizeRun::Impl {
   OptimizeResult result;
   std::vector<std::string> notes;
   int runs = 0;
-  const std::vector<StepReport> no_reports;
+  const std::vector<StepReport> no_reports{};  // reports() of a run without node optimization
 
   bool moving() const { return settings.nodes.enabled; }
   bool discrete() const { return settings.nodes.method == NodeMethod::kDiscrete; }
