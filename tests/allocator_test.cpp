@@ -2,8 +2,13 @@
 #include "core/base/allocator.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <condition_variable>
+#include <cstddef>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -111,6 +116,35 @@ TEST(Allocator, ThreadsShareTheLimitedArenas) {
   EXPECT_GE(arenas, 1);
   EXPECT_LE(arenas, limit) << threads << " threads";
 #endif
+}
+
+// The top pad counts against an address-space or data limit: under one it is at most 1/64 of
+// the limit (checked in a child process, which lowers its own data limit to 640 MB).
+TEST(Allocator, TopPadShrinksUnderAMemoryLimit) {
+  constexpr std::size_t kFull = std::size_t(256) << 20;
+  const auto limit_of = [](int resource) {
+    struct rlimit l {};
+    return getrlimit(resource, &l) == 0 ? l.rlim_cur : RLIM_INFINITY;
+  };
+  std::size_t expected = kFull;
+  for (const int resource : {RLIMIT_AS, RLIMIT_DATA})
+    if (limit_of(resource) != RLIM_INFINITY)
+      expected = std::min<std::size_t>(expected, limit_of(resource) / 64);
+  EXPECT_EQ(kept_memory_top_pad(), expected);
+  constexpr rlim_t kData = rlim_t(640) << 20;
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    struct rlimit l {};
+    if (getrlimit(RLIMIT_DATA, &l) != 0) _exit(2);
+    if (l.rlim_cur == RLIM_INFINITY || l.rlim_cur > kData) l.rlim_cur = kData;
+    if (setrlimit(RLIMIT_DATA, &l) != 0) _exit(3);
+    _exit(kept_memory_top_pad() <= std::size_t(kData / 64) ? 0 : 1);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "1: the pad ignores the limit; 2, 3: getrlimit/setrlimit";
 }
 
 TEST(Allocator, LeavesMallocTunablesOfTheUserAlone) {

@@ -230,6 +230,13 @@ TEST(CliChecks, OutOfMemoryIsACleanExitAndRepeatedIssuesAreSummarized) {
     const long mid = (lo + hi) / 2;
     (runs_in(mid) ? hi : lo) = mid;
   }
+  // The allocator's policy (its padding on) needs no more room under the limit: its top pad
+  // shrinks to a 64th of the limit (a pad of 256 MB needed that much more).
+  EXPECT_EQ(run_limited("ulimit -v " + std::to_string(hi + 64 * 1024),
+                        "validate --mesh " + kMesh + " --layout " + kLayout, nullptr,
+                        "OPENBLAS_NUM_THREADS=1"),
+            0)
+      << "limit " << hi + 64 * 1024 << " KB";
   std::string output;
   const std::string validate = "validate --mesh " + kMesh + " --layout " + layout;
   // Reading the layout needs about 190 MB more than the example.

@@ -1,6 +1,9 @@
 #include "core/base/allocator.h"
 
+#include <sys/resource.h>
+
 #include <algorithm>
+#include <cstddef>
 #include <cstdlib>
 #include <cstring>
 #include <thread>
@@ -10,6 +13,19 @@
 #endif
 
 namespace qs {
+
+std::size_t kept_memory_top_pad() {
+  constexpr std::size_t kTopPad = std::size_t(256) << 20;
+  std::size_t pad = kTopPad;
+  // Under an address-space or data limit (ulimit -v / -d) the pad is reserved against the
+  // limit at every growth of the heap: a run would hit the limit up to the pad earlier.
+  for (const int resource : {RLIMIT_AS, RLIMIT_DATA}) {
+    struct rlimit limit {};
+    if (getrlimit(resource, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+      pad = std::min<std::size_t>(pad, static_cast<std::size_t>(limit.rlim_cur / 64));
+  }
+  return pad;
+}
 
 int kept_memory_arena_limit() {
   return std::max(2, static_cast<int>(std::thread::hardware_concurrency()));
@@ -21,10 +37,9 @@ bool keep_freed_memory() {
   if (tunables && std::strstr(tunables, "glibc.malloc.")) return false;
   constexpr int kMmapThreshold = 32 << 20;  // glibc's maximum (HEAP_MAX_SIZE / 2 on 64 bit)
   constexpr int kTrimThreshold = 1 << 30;
-  constexpr int kTopPad = 256 << 20;
   bool ok = mallopt(M_MMAP_THRESHOLD, kMmapThreshold) == 1;
   ok = (mallopt(M_TRIM_THRESHOLD, kTrimThreshold) == 1) && ok;
-  ok = (mallopt(M_TOP_PAD, kTopPad) == 1) && ok;
+  ok = (mallopt(M_TOP_PAD, static_cast<int>(kept_memory_top_pad())) == 1) && ok;
   ok = (mallopt(M_ARENA_MAX, kept_memory_arena_limit()) == 1) && ok;
   return ok;
 #else

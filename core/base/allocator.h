@@ -13,14 +13,21 @@
 // docs/benchmarks.md, "Design measurements".
 #pragma once
 
+#include <cstddef>
+
 namespace qs {
 
 //! glibc: mallopt() with an mmap threshold of 32 MB (glibc's maximum; larger blocks still get
-//! their own mmap), a trim threshold of 1 GB, a top pad of 256 MB and at most
+//! their own mmap), a trim threshold of 1 GB, a top pad of kept_memory_top_pad() and at most
 //! kept_memory_arena_limit() arenas. Leaves the allocator alone when GLIBC_TUNABLES sets any
 //! glibc.malloc tunable (the user's choice wins) and on other C libraries. \return true when the
 //! policy was applied.
 bool keep_freed_memory();
+
+//! The policy's top pad in bytes: 256 MB, or 1/64 of the address-space or data limit
+//! (getrlimit RLIMIT_AS, RLIMIT_DATA; `ulimit -v`, `ulimit -d`) when that is smaller, since
+//! the pad counts against the limit.
+std::size_t kept_memory_top_pad();
 
 //! The policy's arena count: one per hardware thread, at least 2.
 int kept_memory_arena_limit();
