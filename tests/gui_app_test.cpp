@@ -446,7 +446,8 @@ TEST_F(GuiApp, EdgeLoopIsInsertedAndRemovedWithTheLoopTools) {
 // with both is written. Without a mesh, waiting for them fails the script at once.
 TEST_F(GuiApp, GuidesAreShownAndWaitingWithoutAMeshFails) {
   ASSERT_EQ(run_app({"--mesh", kExampleMesh.string()},
-                    "symmetry auto\nfield_hints on\nwait_guides 120\nframes 2\nscreenshot " +
+                    "symmetry auto\nfield_hints on\nhint_scale 0.1\nwait_guides 120\nframes "
+                    "2\nscreenshot " +
                         p("guides.png") + "\nstate " + p("state.json") + "\nquit\n"),
             0);
   const json s = read_json(path("state.json"));
@@ -463,6 +464,8 @@ TEST_F(GuiApp, GuidesAreShownAndWaitingWithoutAMeshFails) {
   ASSERT_TRUE(singularities.is_array());
   EXPECT_EQ(singularities.size(), 8u);
   for (const auto& v : singularities) EXPECT_EQ(v.at("index"), 1);
+  EXPECT_EQ(s.at("field_hints").at("scale"), 0.1);
+  EXPECT_EQ(s.at("field_hints").at("all_singularities"), 8);
   EXPECT_GT(fs::file_size(path("guides.png")), 1000u);
 
   const auto start = std::chrono::steady_clock::now();

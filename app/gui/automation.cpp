@@ -22,6 +22,7 @@ const std::set<std::string>& command_names() {
                                               "wait_guides",
                                               "symmetry",
                                               "field_hints",
+                                              "hint_scale",
                                               "wireframe",
                                               "wait_step",
                                               "wait_finished",
