@@ -133,10 +133,12 @@ TEST_F(GuiDrag, ShownSolveFollowsTheDragAndUndoRestoresTheStateBefore) {
     ASSERT_TRUE(step_away(editor, id, origin)) << "position " << k;
     ASSERT_TRUE(step_away(editor, id, origin)) << "position " << k;
     const int at = vertex_of(editor.doc.editor.layout(), id);
-    ASSERT_TRUE(poll_until(editor, [&] {
-      const Snapshot* s = editor.result();
-      return s && s->layout && vertex_of(*s->layout, id) == at;
-    })) << "no solve shown for position " << k;
+    ASSERT_TRUE(poll_until(editor,
+                           [&] {
+                             const Snapshot* s = editor.result();
+                             return s && s->layout && vertex_of(*s->layout, id) == at;
+                           }))
+        << "no solve shown for position " << k;
     const Snapshot* s = editor.result();
     EXPECT_EQ(editor.result_kind(), ResultKind::Live);
     EXPECT_FALSE(s->corner_uv.empty());
@@ -166,7 +168,9 @@ TEST_F(GuiDrag, ShownSolveFollowsTheDragAndUndoRestoresTheStateBefore) {
   EXPECT_EQ(after->message, fresh->message);
   // The other nodes stayed where they were.
   for (const auto& n : layout_before.nodes)
-    if (n.id != id) EXPECT_EQ(vertex_of(*after->layout, n.id), n.vertex) << "node " << n.id;
+    if (n.id != id) {
+      EXPECT_EQ(vertex_of(*after->layout, n.id), n.vertex) << "node " << n.id;
+    }
   // Still shown a while later (nothing stale arrives).
   for (int k = 0; k < 20; ++k) {
     editor.poll();

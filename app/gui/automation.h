@@ -1,6 +1,7 @@
 // Automation of the editor for tests, benchmarks and screenshots (docs/interfaces.md §3): the
 // --screenshot / --frames / --quit / --run / --stroke-vertices / --bench-* (--bench-drag:
-// drag_bench.h) / --frame-profile flags, the --state-json dump at exit, and --script files of editor commands.
+// drag_bench.h) / --frame-profile flags, the --state-json dump at exit, and --script files of
+// editor commands.
 //
 // A script has one command per line ('#' starts a comment; a path argument is the rest of its
 // line); one command runs per frame, after the frame was drawn, through the same code as the

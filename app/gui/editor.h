@@ -187,10 +187,10 @@ class Editor {
   WorkerStatus last_status_ = WorkerStatus::Idle;  //!< of the latest snapshot polled
   float mesh_diagonal_ = 1.0f;
   std::uint64_t mesh_diagonal_version_ = ~0ull;
-  bool live_drag_ = false;  //!< the current drag solves live
-  bool releasing_ = false;  //!< inside end_drag() of a live drag
-  bool undoing_ = false;    //!< inside undo() / redo()
-  DragDisplay pre_drag_;    //!< of the current drag
+  bool live_drag_ = false;                //!< the current drag solves live
+  bool releasing_ = false;                //!< inside end_drag() of a live drag
+  bool undoing_ = false;                  //!< inside undo() / redo()
+  DragDisplay pre_drag_;                  //!< of the current drag
   std::optional<DragDisplay> last_drag_;  //!< of the last live drag, until another edit
 };
 

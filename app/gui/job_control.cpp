@@ -41,8 +41,10 @@ JobControl::~JobControl() {
 }
 
 bool JobControl::showable(const Snapshot& s, const Document& doc) const {
+  // Nothing the worker published before it took the latest layout sent.
   return s.mesh && s.mesh == doc.mesh && s.iteration > 0 && s.layout &&
-         s.status != WorkerStatus::Failed && s.status != WorkerStatus::Idle;
+         s.applied_seq >= layout_seq_ && s.status != WorkerStatus::Failed &&
+         s.status != WorkerStatus::Idle;
 }
 
 bool JobControl::held_valid(const Document& doc) const {
@@ -54,7 +56,7 @@ const Snapshot* JobControl::shown(const Document& doc) const {
   // While dragging: the newest live solve (none at an invalid position).
   if (live_.active) {
     return live_.invalid || !live_.shown || live_.shown->mesh != doc.mesh ? nullptr
-                                                                         : live_.shown.get();
+                                                                          : live_.shown.get();
   }
   const bool held = held_valid(doc);
   // A stopped run, a restored result, and a kept result until the worker has moved on, before
@@ -107,13 +109,13 @@ void JobControl::load(const Document& doc) {
   stop_seq_ = 0;
   pending_nodes_.clear();
   pending_arcs_.clear();
-  if (doc.mesh) worker_->send(cmd::LoadMesh{doc.mesh, doc.editor.layout()});
+  if (doc.mesh) layout_seq_ = worker_->send(cmd::LoadMesh{doc.mesh, doc.editor.layout()});
 }
 
 bool JobControl::layout_edited(const Layout& layout) {
   bool dropped = false;
   if (keeping_) {  // keep(): the result becomes the layout, nothing is dropped
-    worker_->send(cmd::SetLayout{layout});
+    layout_seq_ = worker_->send(cmd::SetLayout{layout});
     return false;
   }
   if (held_.kind == ResultKind::Stopped && held_.snapshot) dropped = true;
@@ -125,7 +127,7 @@ bool JobControl::layout_edited(const Layout& layout) {
   live_ = {};
   held_ = {};
   stop_seq_ = 0;
-  worker_->send(cmd::SetLayout{layout});
+  layout_seq_ = worker_->send(cmd::SetLayout{layout});
   return dropped;
 }
 
@@ -139,7 +141,7 @@ void JobControl::start_fresh(const Document& doc) {
   live_ = {};
   held_ = {};
   stop_seq_ = 0;
-  worker_->send(cmd::SetLayout{doc.editor.layout()});
+  layout_seq_ = worker_->send(cmd::SetLayout{doc.editor.layout()});
   send_options();
 }
 
@@ -189,7 +191,7 @@ void JobControl::discard(const Document& doc) {
   live_ = {};
   held_ = {};
   stop_seq_ = 0;
-  if (live) worker_->send(cmd::SetLayout{doc.editor.layout()});
+  if (live) layout_seq_ = worker_->send(cmd::SetLayout{doc.editor.layout()});
 }
 
 bool JobControl::keep(Document& doc) {
@@ -312,7 +314,7 @@ void JobControl::send_live(const Layout& layout, Clock::time_point event) {
   // Run without node optimization: its first step is the initial solve, and the last.
   WorkerOptions fixed = options;
   fixed.node_optimization = false;
-  worker_->send(cmd::SetLayout{layout});  // cancels the solve in flight, if any
+  layout_seq_ = worker_->send(cmd::SetLayout{layout});  // cancels the solve in flight, if any
   worker_->send(cmd::SetOptions{fixed});
   live_.inflight_seq = worker_->send(cmd::Step{});
   live_.inflight_event = event;
@@ -367,8 +369,7 @@ bool JobControl::take_live_released() {
 }
 
 void JobControl::poll_live(const Document& doc) {
-  if (!live_.active || live_.inflight_seq == 0 || latest_->applied_seq < live_.inflight_seq)
-    return;
+  if (!live_.active || live_.inflight_seq == 0 || latest_->applied_seq < live_.inflight_seq) return;
   const WorkerStatus status = latest_->status;
   if (status != WorkerStatus::Finished && status != WorkerStatus::Failed &&
       status != WorkerStatus::Cancelled)

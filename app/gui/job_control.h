@@ -8,8 +8,8 @@
 
 #include <chrono>
 #include <cstdint>
-#include <optional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -178,10 +178,11 @@ class JobControl {
   Held held_;
   Live live_;
   LiveStats live_stats_;
-  SnapshotPtr live_result_;     //!< the release's solve, once read
-  bool live_released_ = false;  //!< take_live_released()
-  bool keeping_ = false;        //!< inside keep()
-  std::uint64_t stop_seq_ = 0;  //!< Stop sent and not yet applied (0: none)
+  SnapshotPtr live_result_;       //!< the release's solve, once read
+  bool live_released_ = false;    //!< take_live_released()
+  bool keeping_ = false;          //!< inside keep()
+  std::uint64_t stop_seq_ = 0;    //!< Stop sent and not yet applied (0: none)
+  std::uint64_t layout_seq_ = 0;  //!< the latest LoadMesh or SetLayout sent
   std::uint64_t stop_generation_ = 0;
   // param_version bookkeeping
   const Snapshot* param_snapshot_ = nullptr;

@@ -1,5 +1,6 @@
 // Pipeline: Run / Pause / Step / Stop, why Run cannot start, the live solve while dragging, the
-// run's state, Keep result / Discard and the step history (the convergence plot is in the Metrics window).
+// run's state, Keep result / Discard and the step history (the convergence plot is in the Metrics
+// window).
 #include <algorithm>
 #include <cmath>
 

@@ -362,8 +362,7 @@ void Tools::mouse(const MouseInput& in, Editor& editor, render::Camera& camera,
           drag_ = Drag::Stroke;
           begin_stroke(press_node_, press_, editor, camera, picker);
           add_stroke_sample(at, editor, camera, picker);
-        } else if (tool_ == Tool::Select && press_node_ >= 0 &&
-                   editor.begin_drag(press_node_)) {
+        } else if (tool_ == Tool::Select && press_node_ >= 0 && editor.begin_drag(press_node_)) {
           drag_ = Drag::MoveNode;
           editor.selection = {press_node_, -1};
           ++editor.interaction_version;
