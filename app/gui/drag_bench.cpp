@@ -72,12 +72,13 @@ bool DragBench::plan(AppContext& ctx) {
   }
   node_ = layout.nodes[chosen].id;
   from_ = screen[chosen];
-  // A half circle towards the middle of the view, within a third of the nearest node's distance.
+  // Three quarters of a circle through the node, its centre towards the middle of the view, its
+  // radius a third of the nearest node's distance.
   float nearest = std::min(ctx.camera.viewport().x, ctx.camera.viewport().y);
   for (std::size_t k = 0; k < layout.nodes.size(); ++k)
     if (k != chosen && screen[k].x > -1e8f)
       nearest = std::min(nearest, glm::length(screen[k] - from_));
-  radius_ = std::clamp(0.3f * nearest, 4.0f, 0.15f * ctx.camera.viewport().y);
+  radius_ = std::clamp(0.35f * nearest, 4.0f, 0.15f * ctx.camera.viewport().y);
   const glm::vec2 to_centre = centre - from_;
   along_ = glm::length(to_centre) > 1.0f ? glm::normalize(to_centre) : glm::vec2(1.0f, 0.0f);
   return true;
@@ -99,13 +100,13 @@ bool DragBench::after_frame(AppContext& ctx) {
       phase_ = Phase::Drag;
       [[fallthrough]];
     case Phase::Drag: {
-      // One mouse event per frame: the press, positions 1..N along the half circle, the release.
+      // One mouse event per frame: the press, positions 1..N along the path, the release.
       MouseInput in;
       in.left_down = true;
-      const float t = float(std::min(next_, positions_)) / float(positions_);
+      const float turn = 1.5f * kPi * float(std::min(next_, positions_)) / float(positions_);
       const glm::vec2 across(-along_.y, along_.x);
       in.position =
-          from_ + radius_ * ((1.0f - std::cos(kPi * t)) * along_ + std::sin(kPi * t) * across);
+          from_ + radius_ * ((1.0f - std::cos(turn)) * along_ + std::sin(turn) * across);
       if (next_ == 0) {
         in.left_clicked = true;
         first_event_ = now;

@@ -39,7 +39,7 @@ class DragBench {
   int node_ = -1;
   glm::vec2 from_{0.0f};
   glm::vec2 along_{1.0f, 0.0f};  //!< unit direction of the path's chord on screen
-  float radius_ = 0.0f;          //!< of the half circle the path follows (pixels)
+  float radius_ = 0.0f;          //!< of the circle the path follows (pixels)
   int next_ = 0;                 //!< next mouse position (0: the press)
   int moves_ = 0;                //!< positions that moved the node
   Clock::time_point first_event_;
