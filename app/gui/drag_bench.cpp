@@ -105,8 +105,7 @@ bool DragBench::after_frame(AppContext& ctx) {
       in.left_down = true;
       const float turn = 1.5f * kPi * float(std::min(next_, positions_)) / float(positions_);
       const glm::vec2 across(-along_.y, along_.x);
-      in.position =
-          from_ + radius_ * ((1.0f - std::cos(turn)) * along_ + std::sin(turn) * across);
+      in.position = from_ + radius_ * ((1.0f - std::cos(turn)) * along_ + std::sin(turn) * across);
       if (next_ == 0) {
         in.left_clicked = true;
         first_event_ = now;
@@ -171,13 +170,14 @@ std::string DragBench::report(const AppContext& ctx) const {
       "bench-drag: node %d over %d mouse positions (%d moved it) in %.2f s; mesh %zu faces, "
       "%zu nodes, %zu arcs; %d solves shown (%d while dragging): %.1f solves/s while "
       "dragging, %.1f overall; latency mouse event -> solve shown: median %.0f ms, max %.0f "
-      "ms; release -> its solve shown %.0f ms; worker time per solve: median %.0f ms",
+      "ms; release -> its solve shown %.0f ms; worker time per solve: median %.0f ms, max %.0f "
+      "ms",
       node_, positions_, moves_, drag_s,
       editor.doc.mesh ? std::size_t(editor.doc.mesh->n_faces()) : std::size_t(0),
       editor.doc.editor.layout().nodes.size(), editor.doc.editor.layout().arcs.size(), shown,
       shown_while_dragging_, drag_s > 0 ? shown_while_dragging_ / drag_s : 0.0,
       total_s > 0 ? shown / total_s : 0.0, median(latency_ms_), max_of(latency_ms_),
-      release_latency_ms_, median(solve_ms_));
+      release_latency_ms_, median(solve_ms_), max_of(solve_ms_));
   return std::string(line) + "; after the release: " + final_ +
          "; renderer: " + (renderer.empty() ? "?" : renderer);
 }
