@@ -54,17 +54,21 @@ bool DragBench::plan(AppContext& ctx) {
     if (v >= 0 && v < int(mesh.n_vertices()))
       screen[k] = glm::vec2(ctx.camera.project(vertex_point(mesh, v)));
   }
-  // The free node nearest to the middle of the view that is picked where it is drawn.
+  // Visible: picked where it is drawn (not behind the surface).
+  std::vector<char> visible(layout.nodes.size(), 0);
+  for (std::size_t k = 0; k < layout.nodes.size(); ++k)
+    visible[k] = screen[k].x > -1e8f && ctx.tools.pick_node(screen[k], 6.0f, editor, ctx.camera,
+                                                            ctx.picker) == layout.nodes[k].id;
+  // The free visible node nearest to the middle of the view.
   float best = std::numeric_limits<float>::max();
   std::size_t chosen = layout.nodes.size();
   for (std::size_t k = 0; k < layout.nodes.size(); ++k) {
-    if (layout.nodes[k].pinned || screen[k].x < -1e8f) continue;
+    if (layout.nodes[k].pinned || !visible[k]) continue;
     const float d = glm::length(screen[k] - centre);
-    if (d >= best) continue;
-    if (ctx.tools.pick_node(screen[k], 6.0f, editor, ctx.camera, ctx.picker) != layout.nodes[k].id)
-      continue;
-    best = d;
-    chosen = k;
+    if (d < best) {
+      best = d;
+      chosen = k;
+    }
   }
   if (chosen == layout.nodes.size()) {
     error_ = "no free node of the layout is in view";
@@ -73,12 +77,12 @@ bool DragBench::plan(AppContext& ctx) {
   node_ = layout.nodes[chosen].id;
   from_ = screen[chosen];
   // Three quarters of a circle through the node, its centre towards the middle of the view, its
-  // radius a third of the nearest node's distance.
-  float nearest = std::min(ctx.camera.viewport().x, ctx.camera.viewport().y);
+  // radius a third of the nearest visible node's distance.
+  const float height = ctx.camera.viewport().y;
+  float nearest = height;
   for (std::size_t k = 0; k < layout.nodes.size(); ++k)
-    if (k != chosen && screen[k].x > -1e8f)
-      nearest = std::min(nearest, glm::length(screen[k] - from_));
-  radius_ = std::clamp(0.35f * nearest, 4.0f, 0.15f * ctx.camera.viewport().y);
+    if (k != chosen && visible[k]) nearest = std::min(nearest, glm::length(screen[k] - from_));
+  radius_ = std::clamp(0.35f * nearest, 0.02f * height, 0.15f * height);
   const glm::vec2 to_centre = centre - from_;
   along_ = glm::length(to_centre) > 1.0f ? glm::normalize(to_centre) : glm::vec2(1.0f, 0.0f);
   return true;
@@ -115,8 +119,19 @@ bool DragBench::after_frame(AppContext& ctx) {
         phase_ = Phase::Wait;
       }
       const std::uint64_t version = editor.doc.editor.version();
+      const auto before = Clock::now();
       ctx.tools.mouse(in, editor, ctx.camera, ctx.picker);
-      if (next_ > 0 && next_ <= positions_ && editor.doc.editor.version() != version) ++moves_;
+      if (editor.doc.editor.version() != version)
+        ui_ms_.push_back(std::chrono::duration<double, std::milli>(Clock::now() - before).count());
+      if (next_ > 0 && next_ <= positions_) {
+        if (editor.doc.editor.version() != version) ++moves_;
+        const std::string& status = editor.status();
+        if (status.rfind("Cannot move there", 0) == 0) {
+          ++refused_;
+          if (refusal_.empty()) refusal_ = status;
+          editor.set_status("");
+        }
+      }
       ++next_;
       return false;
     }
@@ -168,17 +183,22 @@ std::string DragBench::report(const AppContext& ctx) const {
   std::snprintf(
       line, sizeof(line),
       "bench-drag: node %d over %d mouse positions (%d moved it) in %.2f s; mesh %zu faces, "
-      "%zu nodes, %zu arcs; %d solves shown (%d while dragging): %.1f solves/s while "
+      "%zu nodes, %zu arcs; %d solves asked for, %d sent, %d shown (%d while dragging): %.1f "
+      "solves/s while "
       "dragging, %.1f overall; latency mouse event -> solve shown: median %.0f ms, max %.0f "
       "ms; release -> its solve shown %.0f ms; worker time per solve: median %.0f ms, max %.0f "
-      "ms",
+      "ms; UI thread per move (route, validate, ask): median %.0f ms",
       node_, positions_, moves_, drag_s,
       editor.doc.mesh ? std::size_t(editor.doc.mesh->n_faces()) : std::size_t(0),
-      editor.doc.editor.layout().nodes.size(), editor.doc.editor.layout().arcs.size(), shown,
-      shown_while_dragging_, drag_s > 0 ? shown_while_dragging_ / drag_s : 0.0,
-      total_s > 0 ? shown / total_s : 0.0, median(latency_ms_), max_of(latency_ms_),
-      release_latency_ms_, median(solve_ms_), max_of(solve_ms_));
-  return std::string(line) + "; after the release: " + final_ +
+      editor.doc.editor.layout().nodes.size(), editor.doc.editor.layout().arcs.size(),
+      editor.job.live_stats().requests, editor.job.live_stats().sent, shown, shown_while_dragging_,
+      drag_s > 0 ? shown_while_dragging_ / drag_s : 0.0, total_s > 0 ? shown / total_s : 0.0,
+      median(latency_ms_), max_of(latency_ms_), release_latency_ms_, median(solve_ms_),
+      max_of(solve_ms_), median(ui_ms_));
+  std::string refused;
+  if (refused_ > 0)
+    refused = "; " + std::to_string(refused_) + " positions refused (" + refusal_ + ")";
+  return std::string(line) + refused + "; after the release: " + final_ +
          "; renderer: " + (renderer.empty() ? "?" : renderer);
 }
 

@@ -42,6 +42,8 @@ class DragBench {
   float radius_ = 0.0f;          //!< of the circle the path follows (pixels)
   int next_ = 0;                 //!< next mouse position (0: the press)
   int moves_ = 0;                //!< positions that moved the node
+  int refused_ = 0;              //!< positions the drag refused
+  std::string refusal_;          //!< the first refusal's reason
   Clock::time_point first_event_;
   Clock::time_point release_;
   Clock::time_point end_;
@@ -49,6 +51,7 @@ class DragBench {
   int shown_while_dragging_ = 0;
   std::vector<double> latency_ms_;    //!< mouse event -> frame shown, per solve shown
   std::vector<double> solve_ms_;      //!< worker time (StepMetrics::total_ms) per solve shown
+  std::vector<double> ui_ms_;         //!< UI thread time per mouse event that moved the node
   double release_latency_ms_ = -1.0;  //!< release -> its solve shown
   std::string final_;                 //!< the result after the release
   std::string error_;
