@@ -3,7 +3,7 @@
 // what is shown after the release is the solve of the released layout (as Run without node
 // optimization computes it on a fresh worker), undo and redo bring back the results shown
 // before and after the drag, drag positions issued faster than they are solved supersede each
-// other, and the option turns it off.
+// other, an invalid position shows its issues instead of a solve, and the option turns it off.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -249,6 +249,46 @@ TEST_F(GuiDrag, CancelRestoresTheResultShownBefore) {
     std::this_thread::sleep_for(5ms);
   }
   EXPECT_EQ(editor.result(), nullptr);
+}
+
+// A drag position where the layout is invalid shows its validation issues, not a solve: here
+// the example without arc 10 (a 6-sided patch) at every position.
+TEST_F(GuiDrag, InvalidPositionShowsItsIssuesInsteadOfASolve) {
+  Editor editor(config());
+  ASSERT_TRUE(editor.start("", ""));
+  ASSERT_TRUE(editor.doc.editor.delete_arc(10));
+  editor.poll();
+  ASSERT_GT(editor.doc.validation.errors(), 0);
+  const int id = free_node(editor);
+  const int origin = vertex_of(editor.doc.editor.layout(), id);
+  ASSERT_TRUE(editor.begin_drag(id));
+  bool moved = false;
+  for (const auto vh : editor.doc.mesh->vv_range(OpenMesh::VertexHandle(origin))) {
+    const std::uint64_t version = editor.doc.editor.version();
+    if (editor.drag_to(vh.idx()) && editor.doc.editor.version() != version) {
+      moved = true;
+      break;
+    }
+  }
+  ASSERT_TRUE(moved);
+  EXPECT_GT(editor.doc.validation.errors(), 0);
+  EXPECT_EQ(editor.status().rfind("Invalid here: ", 0), 0u) << editor.status();
+  EXPECT_TRUE(editor.job.live());
+  for (int k = 0; k < 20; ++k) {
+    editor.poll();
+    std::this_thread::sleep_for(5ms);
+  }
+  EXPECT_EQ(editor.result(), nullptr);
+  EXPECT_EQ(editor.job.live_stats().sent, 0);
+  editor.end_drag();
+  for (int k = 0; k < 20; ++k) {
+    editor.poll();
+    std::this_thread::sleep_for(5ms);
+  }
+  EXPECT_FALSE(editor.job.live());
+  EXPECT_EQ(editor.result(), nullptr);
+  EXPECT_EQ(editor.job.live_stats().sent, 0);
+  EXPECT_GT(editor.doc.validation.errors(), 0);
 }
 
 // With "Live solve while dragging" off, a drag solves nothing; the release is a plain edit.
