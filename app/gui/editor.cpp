@@ -491,6 +491,7 @@ EditResult Editor::drag_to(int vertex) {
     job.live_invalid();
     set_status("Invalid here: " + first_error(doc.validation));
   } else {
+    if (status_.rfind("Invalid here: ", 0) == 0) set_status("");
     job.live_request(doc.editor.layout(), event);
   }
   return r;
