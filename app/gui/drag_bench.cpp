@@ -187,7 +187,7 @@ std::string DragBench::report(const AppContext& ctx) const {
       "solves/s while "
       "dragging, %.1f overall; latency mouse event -> solve shown: median %.0f ms, max %.0f "
       "ms; release -> its solve shown %.0f ms; worker time per solve: median %.0f ms, max %.0f "
-      "ms; UI thread per move (route, validate, ask): median %.0f ms",
+      "ms; UI thread per move (route, validate, ask): median %.1f ms",
       node_, positions_, moves_, drag_s,
       editor.doc.mesh ? std::size_t(editor.doc.mesh->n_faces()) : std::size_t(0),
       editor.doc.editor.layout().nodes.size(), editor.doc.editor.layout().arcs.size(),
