@@ -88,8 +88,9 @@ class JobControl {
   // Live solves while a node is dragged. Each is the solve of Run without node optimization
   // (the engine's initial solve, with the quad mesh) of one drag position's layout, on the
   // worker. At most one is in flight; a newer position replaces the pending one, so no stale
-  // position is ever queued. Any other command (load, edit, run, step, stop, discard, keep)
-  // ends live solving.
+  // position is ever queued. The solve in flight runs to its end and is shown (it is the newest
+  // that can be shown soonest); only the release cancels it. Any other command (load, edit,
+  // run, step, stop, discard, keep) ends live solving.
   using Clock = std::chrono::steady_clock;
   //! Asks for the solve of \p layout, the drag position of the mouse event at \p event: sent
   //! at once when no live solve is in flight, else kept as the pending request (replacing an
