@@ -476,4 +476,28 @@ TEST_F(GuiApp, GuidesAreShownAndWaitingWithoutAMeshFails) {
   EXPECT_NE(text.find("wait_guides: no mesh is open"), std::string::npos) << text;
 }
 
+// The live-drag benchmark: a scripted drag of one node of the example layout, its numbers
+// printed, the result after the release the solve of the released layout; the state dump shows
+// the moved node.
+TEST_F(GuiApp, BenchDragDragsANodeAndPrintsItsNumbers) {
+  ASSERT_EQ(run_app({"--bench-drag", "20", "--state-json", p("state.json")}, ""), 0);
+  std::ifstream log(path("run1.log"));
+  const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+  const auto line = text.find("bench-drag: node ");
+  ASSERT_NE(line, std::string::npos) << text;
+  const std::string bench = text.substr(line, text.find('\n', line) - line);
+  EXPECT_NE(bench.find("over 20 mouse positions"), std::string::npos) << bench;
+  EXPECT_NE(bench.find("solves/s while dragging"), std::string::npos) << bench;
+  EXPECT_NE(bench.find("latency mouse event -> solve shown: median "), std::string::npos) << bench;
+  EXPECT_NE(bench.find("after the release: step 1, initial solve: E = "), std::string::npos)
+      << bench;
+  EXPECT_EQ(bench.find(" 0 shown"), std::string::npos) << bench;
+  const json s = read_json(path("state.json"));
+  ASSERT_FALSE(s.is_null());
+  EXPECT_TRUE(s.at("document").at("dirty").get<bool>()) << "the drag moved no node";
+  EXPECT_EQ(s.at("document").at("can_undo"), true);
+  ASSERT_FALSE(s.at("result").is_null());
+  EXPECT_EQ(s.at("result").at("status"), "finished");
+}
+
 }  // namespace

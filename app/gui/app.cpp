@@ -152,7 +152,7 @@ bool App::frame(const glm::ivec2& framebuffer, float dt) {
   renderer_.begin_ui_frame();
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
-  tools_.mouse(read_mouse(), editor_, camera_, picker_);
+  if (!automation_.drives_mouse()) tools_.mouse(read_mouse(), editor_, camera_, picker_);
   handle_keys(key_presses_, ctx);
   draw_ui(ctx);
   ImGui::Render();

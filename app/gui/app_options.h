@@ -34,6 +34,9 @@ struct AppOptions {
   //! A free-hand stroke through the screen positions of these mesh vertices (the first must
   //! hold a node), applied like a mouse stroke with the stroke tool.
   std::vector<int> stroke_vertices;
+  //! Live-drag benchmark (drag_bench.h): drag one node over this many mouse positions, one per
+  //! frame, print the live solves shown per second and their latency, then quit. 0: off.
+  int bench_drag = 0;
   //! Orbit the camera a little every frame (the scene re-renders every frame, the worst case
   //! for the frame rate).
   bool bench_orbit = false;

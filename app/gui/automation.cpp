@@ -89,7 +89,9 @@ bool parse_double(const std::string& s, double& out) {
 
 }  // namespace
 
-Automation::Automation(const AppOptions& options) : options_(options) {}
+Automation::Automation(const AppOptions& options) : options_(options) {
+  if (options_.bench_drag > 0) drag_bench_.emplace(options_.bench_drag);
+}
 
 bool Automation::load(std::string* error) {
   if (options_.script_path.empty()) return true;
@@ -404,6 +406,7 @@ bool Automation::after_frame(AppContext& ctx, const glm::ivec2& framebuffer) {
       run_requested_ = true;
     }
   }
+  if (drag_bench_ && drag_bench_->after_frame(ctx)) quit_ = true;
   // The script: one command per frame (waits hold it).
   if (next_ < script_.size() && !quit_ && frame_count_ >= 2) {
     if (run_command(script_[next_], ctx, framebuffer)) ++next_;
@@ -448,6 +451,7 @@ void Automation::frame_shown(AppContext& ctx, double ms, bool scene_rendered) {
   const SnapshotPtr& latest = ctx.editor.job.latest();
   frame_stats_.add_frame(ms, scene_rendered, latest ? latest->version : 0,
                          ctx.editor.job.published_version());
+  if (drag_bench_) drag_bench_->frame_shown(ctx);
   if (options_.bench_frames > 0 && frame_count_ == kBenchWarmup) {
     frame_stats_.clear_times();  // the timed frames start now
     bench_start_version_ = ctx.editor.job.published_version();
@@ -483,6 +487,10 @@ void Automation::finish(AppContext& ctx, const glm::ivec2& framebuffer) {
         renderer.field_layer().visible ? "on" : "off", renderer.cache().samples(),
         renderer.cache().enabled() ? "on" : "off", options_.motion_resolution, options_.worker_nice,
         name.empty() ? "?" : name.c_str());
+  }
+  if (drag_bench_) {
+    std::printf("%s\n", drag_bench_->report(ctx).c_str());
+    if (drag_bench_->failed()) exit_code_ = 1;
   }
   if (options_.frames > 0 && stats.frames > 0)
     std::printf("%s\n", format_frame_summary(stats).c_str());

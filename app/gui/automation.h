@@ -1,6 +1,7 @@
 // Automation of the editor for tests, benchmarks and screenshots (docs/interfaces.md §3): the
-// --screenshot / --frames / --quit / --run / --stroke-vertices / --bench-* / --frame-profile
-// flags, the --state-json dump at exit, and --script files of editor commands.
+// --screenshot / --frames / --quit / --run / --stroke-vertices / --bench-* (--bench-drag:
+// drag_bench.h) / --frame-profile flags, the --state-json dump at exit, and --script files of
+// editor commands.
 //
 // A script has one command per line ('#' starts a comment; a path argument is the rest of its
 // line); one command runs per frame, after the frame was drawn, through the same code as the
@@ -39,11 +40,13 @@
 
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "app/gui/app_options.h"
 #include "app/gui/context.h"
+#include "app/gui/drag_bench.h"
 #include "app/gui/frame_stats.h"
 #include "render/renderer.h"
 
@@ -58,7 +61,11 @@ class Automation {
   //! With --quit (and no script), files that cannot be opened end the app before any window.
   bool quit_on_load_error() const { return options_.quit && options_.script_path.empty(); }
   //! Frame timings matter (benchmarks, --frames): no vertical sync, the GPU waited for.
-  bool timed() const { return options_.bench_frames > 0 || options_.frames > 0; }
+  bool timed() const {
+    return options_.bench_frames > 0 || options_.frames > 0 || options_.bench_drag > 0;
+  }
+  //! The mouse is scripted (--bench-drag): the window's own mouse input is ignored.
+  bool drives_mouse() const { return drag_bench_.has_value(); }
 
   //! Before a frame: the benchmark's camera orbit.
   void before_frame(AppContext& ctx);
@@ -97,6 +104,7 @@ class Automation {
   int frames_since_run_done_ = -1;
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   FrameStats frame_stats_;
+  std::optional<DragBench> drag_bench_;
   static constexpr int kBenchWarmup = 10;
   std::uint64_t bench_start_version_ = 0;
   int bench_start_iteration_ = 0;

@@ -38,6 +38,13 @@ fs::path documents_dir() {
   return fs::current_path(ec);
 }
 
+// The first error of \p validation ("" without errors).
+std::string first_error(const ValidationResult& validation) {
+  for (const auto& issue : validation.issues)
+    if (issue.severity == IssueSeverity::Error) return issue.message;
+  return {};
+}
+
 }  // namespace
 
 std::string lower_extension(const std::string& path) {
@@ -156,6 +163,7 @@ bool Editor::open_file(const std::string& path) {
 void Editor::after_document_changed() {
   selection = {};
   highlighted_issue = -1;
+  last_drag_.reset();
   ++interaction_version;
   save_path = default_save_path();
   job.load(doc);
@@ -274,6 +282,9 @@ void Editor::on_layout_edited(const Layout& layout) {
   } catch (const std::exception& e) {
     autosave_error = e.what();
   }
+  // Another edit than the live drag's: its undo no longer brings back the result shown before.
+  if (!undoing_ && !releasing_) last_drag_.reset();
+  if (releasing_) return;  // end_drag() sends the released layout's live solve
   if (job.layout_edited(layout)) {
     const std::string note = "the run's result was discarded (not kept)";
     pending_note_ = pending_note_.empty() ? note : pending_note_ + "; " + note;
@@ -284,7 +295,12 @@ void Editor::poll() {
   if (job.poll(doc)) {
     // The end of a run replaces the "Running" message.
     const Snapshot& s = *job.latest();
-    if (s.status != last_status_ && s.mesh == doc.mesh) {
+    if (job.take_live_released()) {
+      if (s.mesh == doc.mesh)
+        set_status(s.status == WorkerStatus::Finished
+                       ? "Solved the moved layout: " + s.message
+                       : "The moved layout cannot be solved: " + s.message);
+    } else if (!job.latest_is_live() && s.status != last_status_ && s.mesh == doc.mesh) {
       if (s.status == WorkerStatus::Finished)
         set_status("Run finished at step " + std::to_string(s.iteration) +
                    ": Keep result adopts it, Discard drops it");
@@ -310,14 +326,8 @@ std::string Editor::run_blocker() {
   if (layout.arcs.empty()) return "the layout has no arcs: draw arcs between the nodes (tool 3)";
   const int errors = doc.validation.errors();
   if (errors > 0) {
-    std::string first;
-    for (const auto& issue : doc.validation.issues)
-      if (issue.severity == IssueSeverity::Error) {
-        first = issue.message;
-        break;
-      }
     return std::to_string(errors) + " validation error" + (errors == 1 ? "" : "s") +
-           " to fix first: " + first;
+           " to fix first: " + first_error(doc.validation);
   }
   return {};
 }
@@ -458,6 +468,66 @@ void Editor::select(int node, int arc) {
                         : "");
 }
 
+bool Editor::begin_drag(int node_id) {
+  if (!doc.editor.begin_drag(node_id)) return false;
+  live_drag_ = live_solve && doc.mesh && !job.running() && !job.paused();
+  if (live_drag_) {
+    pre_drag_ = {};
+    pre_drag_.before_position = doc.editor.undo_position();
+    pre_drag_.before = job.shown_snapshot(doc);
+    pre_drag_.before_kind = job.shown_kind(doc);
+  }
+  return true;
+}
+
+EditResult Editor::drag_to(int vertex) {
+  const auto event = JobControl::Clock::now();
+  const std::uint64_t version = doc.editor.version();
+  EditResult r = doc.editor.drag_to(vertex);
+  if (!r || !live_drag_ || doc.editor.version() == version) return r;
+  // Validated here (quick next to a solve); an invalid position is shown, not solved.
+  doc.refresh_validation();
+  if (doc.validation.errors() > 0) {
+    job.live_invalid();
+    set_status("Invalid here: " + first_error(doc.validation));
+  } else {
+    if (status_.rfind("Invalid here: ", 0) == 0) set_status("");
+    job.live_request(doc.editor.layout(), event);
+  }
+  return r;
+}
+
+void Editor::end_drag() {
+  if (!doc.editor.dragging()) return;
+  const bool live = live_drag_ && job.live();
+  live_drag_ = false;
+  if (!live) {
+    doc.editor.end_drag();
+    return;
+  }
+  const std::uint64_t version = doc.editor.version();
+  releasing_ = true;
+  doc.editor.end_drag();  // the undo step (on_layout_edited leaves the worker to us)
+  releasing_ = false;
+  doc.refresh_validation();
+  if (doc.validation.errors() > 0)
+    job.layout_edited(doc.editor.layout());  // shown like any invalid layout
+  else
+    job.live_release(doc.editor.layout(), JobControl::Clock::now());
+  if (doc.editor.version() != version) last_drag_ = pre_drag_;
+}
+
+void Editor::cancel_drag() {
+  if (!doc.editor.dragging()) return;
+  const bool live = live_drag_ && job.live();
+  live_drag_ = false;
+  doc.editor.cancel_drag();
+  if (live) {
+    job.layout_edited(doc.editor.layout());
+    job.restore(pre_drag_.before, pre_drag_.before_kind, doc);
+  }
+}
+
 bool Editor::node_pinned(int id) const {
   if (job.live_pins()) return job.node_pinned(id);
   const Snapshot* s = result();
@@ -533,12 +603,31 @@ void Editor::delete_selection() {
 
 void Editor::undo() {
   const std::string label = doc.editor.undo_label();
-  if (doc.editor.undo()) set_status("Undid " + label);
+  // Undoing the last live drag: the result shown before it comes back (and the release's solve
+  // is kept for redo, once it arrived).
+  const bool drag_step =
+      last_drag_ && doc.editor.undo_position() == last_drag_->before_position + 1;
+  const SnapshotPtr after = drag_step && !job.live() ? job.shown_snapshot(doc) : nullptr;
+  undoing_ = true;
+  const bool done = doc.editor.undo();
+  undoing_ = false;
+  if (!done) return;
+  if (drag_step) {
+    last_drag_->after = after;
+    job.restore(last_drag_->before, last_drag_->before_kind, doc);
+  }
+  set_status("Undid " + label);
 }
 
 void Editor::redo() {
   const std::string label = doc.editor.redo_label();
-  if (doc.editor.redo()) set_status("Redid " + label);
+  const bool drag_step = last_drag_ && doc.editor.undo_position() == last_drag_->before_position;
+  undoing_ = true;
+  const bool done = doc.editor.redo();
+  undoing_ = false;
+  if (!done) return;
+  if (drag_step && last_drag_->after) job.restore(last_drag_->after, ResultKind::Live, doc);
+  set_status("Redid " + label);
 }
 
 std::vector<int> Editor::highlight_issue(int index) {

@@ -64,6 +64,9 @@ class Editor {
   SymmetryState symmetry;
   //! The natural cross field of the bare mesh (the View panel's "Field hints").
   FieldHints field_hints;
+  //! "Live solve while dragging" (Pipeline panel): while a node is dragged and no run is in
+  //! progress, every drag position is solved on the worker and shown (JobControl::live_request).
+  bool live_solve = true;
 
   // Start-up and files. Failures are reported (errors()) and leave the document as it was.
   //! Opens \p mesh_path and \p layout_path, or the bundled example when \p mesh_path is empty,
@@ -123,6 +126,19 @@ class Editor {
   void insert_edge_loop(int arc_id);
   void remove_edge_loop(int arc_id);
   void select(int node, int arc);
+  // Dragging a node (the select tool): LayoutEditor's drag with the live solves. With
+  // live_solve on and no run in progress (running or paused), every position is validated
+  // and, when valid, solved on the worker; an invalid one shows its issues instead. The
+  // release solves the final layout (what is shown after it is that solve), and undoing the
+  // move restores the layout and the result shown before the drag (redo: the one after it).
+  //! Starts dragging node \p node_id; false when it cannot (LayoutEditor::begin_drag).
+  bool begin_drag(int node_id);
+  //! Moves the dragged node to \p vertex (LayoutEditor::drag_to) and asks for its solve.
+  EditResult drag_to(int vertex);
+  //! Releases the node: one undoable edit when it moved.
+  void end_drag();
+  //! Esc: the node goes back, and so does the result shown.
+  void cancel_drag();
   //! Pins / unpins: in the running (or paused) job when there is one, else in the layout; with
   //! symmetry on, the mirror node or arc too.
   void toggle_node_pin(int id);
@@ -152,6 +168,13 @@ class Editor {
 
  private:
   void on_layout_edited(const Layout& layout);
+  //! What was shown before and after a live drag, for its undo and redo.
+  struct DragDisplay {
+    std::size_t before_position = 0;  //!< LayoutEditor::undo_position() before the move
+    SnapshotPtr before;
+    ResultKind before_kind = ResultKind::None;
+    SnapshotPtr after;  //!< the release's solve (taken when the move is undone)
+  };
   //! The mirrored sketching's axis and plane (when computed) into the job's options.
   void symmetry_to_job();
   //! After the whole layout was replaced (open, restore): selection reset, worker reloaded.
@@ -164,6 +187,11 @@ class Editor {
   WorkerStatus last_status_ = WorkerStatus::Idle;  //!< of the latest snapshot polled
   float mesh_diagonal_ = 1.0f;
   std::uint64_t mesh_diagonal_version_ = ~0ull;
+  bool live_drag_ = false;                //!< the current drag solves live
+  bool releasing_ = false;                //!< inside end_drag() of a live drag
+  bool undoing_ = false;                  //!< inside undo() / redo()
+  DragDisplay pre_drag_;                  //!< of the current drag
+  std::optional<DragDisplay> last_drag_;  //!< of the last live drag, until another edit
 };
 
 //! Lower-case extension of \p path with its dot (".obj").

@@ -41,8 +41,10 @@ JobControl::~JobControl() {
 }
 
 bool JobControl::showable(const Snapshot& s, const Document& doc) const {
+  // Nothing the worker published before it took the latest layout sent.
   return s.mesh && s.mesh == doc.mesh && s.iteration > 0 && s.layout &&
-         s.status != WorkerStatus::Failed && s.status != WorkerStatus::Idle;
+         s.applied_seq >= layout_seq_ && s.status != WorkerStatus::Failed &&
+         s.status != WorkerStatus::Idle;
 }
 
 bool JobControl::held_valid(const Document& doc) const {
@@ -51,9 +53,15 @@ bool JobControl::held_valid(const Document& doc) const {
 }
 
 const Snapshot* JobControl::shown(const Document& doc) const {
+  // While dragging: the newest live solve (none at an invalid position).
+  if (live_.active) {
+    return live_.invalid || !live_.shown || live_.shown->mesh != doc.mesh ? nullptr
+                                                                          : live_.shown.get();
+  }
   const bool held = held_valid(doc);
-  // A stopped run, and a kept result until the worker has moved on, before the worker's state.
-  if (held && (held_.kind == ResultKind::Stopped || held_.snapshot == latest_))
+  // A stopped run, a restored result, and a kept result until the worker has moved on, before
+  // the worker's state.
+  if (held && (held_.kind == ResultKind::Stopped || held_.restored || held_.snapshot == latest_))
     return held_.snapshot.get();
   if (latest_ && showable(*latest_, doc)) return latest_.get();
   if (held) return held_.snapshot.get();
@@ -63,8 +71,27 @@ const Snapshot* JobControl::shown(const Document& doc) const {
 ResultKind JobControl::shown_kind(const Document& doc) const {
   const Snapshot* s = shown(doc);
   if (!s) return ResultKind::None;
-  if (s == held_.snapshot.get() && held_valid(doc)) return held_.kind;
+  if (!live_.active && s == held_.snapshot.get() && held_valid(doc)) return held_.kind;
   return ResultKind::Live;
+}
+
+SnapshotPtr JobControl::shown_snapshot(const Document& doc) const {
+  const Snapshot* s = shown(doc);
+  if (!s) return nullptr;
+  if (s == live_.shown.get()) return live_.shown;
+  if (s == held_.snapshot.get()) return held_.snapshot;
+  return latest_;
+}
+
+void JobControl::restore(SnapshotPtr snapshot, ResultKind kind, const Document& doc) {
+  if (!snapshot || kind == ResultKind::None) return;
+  live_ = {};
+  held_ = {};
+  held_.snapshot = std::move(snapshot);
+  held_.kind = kind;
+  held_.layout_version = doc.editor.version();
+  held_.mesh = doc.mesh.get();
+  held_.restored = true;
 }
 
 bool JobControl::running() const {
@@ -77,26 +104,30 @@ bool JobControl::paused() const {
 }
 
 void JobControl::load(const Document& doc) {
+  live_ = {};
   held_ = {};
   stop_seq_ = 0;
   pending_nodes_.clear();
   pending_arcs_.clear();
-  if (doc.mesh) worker_->send(cmd::LoadMesh{doc.mesh, doc.editor.layout()});
+  if (doc.mesh) layout_seq_ = worker_->send(cmd::LoadMesh{doc.mesh, doc.editor.layout()});
 }
 
 bool JobControl::layout_edited(const Layout& layout) {
   bool dropped = false;
   if (keeping_) {  // keep(): the result becomes the layout, nothing is dropped
-    worker_->send(cmd::SetLayout{layout});
+    layout_seq_ = worker_->send(cmd::SetLayout{layout});
     return false;
   }
   if (held_.kind == ResultKind::Stopped && held_.snapshot) dropped = true;
+  // A live solve is no run result: dropping it is no news.
   if (latest_ && latest_->iteration > 0 && latest_->layout && latest_->mesh &&
-      latest_->status != WorkerStatus::Idle && latest_->status != WorkerStatus::Failed)
+      latest_->status != WorkerStatus::Idle && latest_->status != WorkerStatus::Failed &&
+      !latest_is_live())
     dropped = true;
+  live_ = {};
   held_ = {};
   stop_seq_ = 0;
-  worker_->send(cmd::SetLayout{layout});
+  layout_seq_ = worker_->send(cmd::SetLayout{layout});
   return dropped;
 }
 
@@ -107,9 +138,10 @@ void JobControl::send_options() {
 void JobControl::start_fresh(const Document& doc) {
   // A new run starts from the edited layout (not from an earlier run's state), without the
   // pins toggled during that run, and replaces the result shown (stopped or kept).
+  live_ = {};
   held_ = {};
   stop_seq_ = 0;
-  worker_->send(cmd::SetLayout{doc.editor.layout()});
+  layout_seq_ = worker_->send(cmd::SetLayout{doc.editor.layout()});
   send_options();
 }
 
@@ -146,6 +178,7 @@ void JobControl::stop(const Document& doc) {
   }
   held.mesh = doc.mesh.get();
   held.layout_version = doc.editor.version();
+  live_ = {};
   stop_generation_ = latest_ ? latest_->generation : 0;
   held_ = std::move(held);
   stop_seq_ = worker_->send(cmd::Stop{});
@@ -154,20 +187,22 @@ void JobControl::stop(const Document& doc) {
 }
 
 void JobControl::discard(const Document& doc) {
-  const bool live = latest_ && showable(*latest_, doc);
+  const bool live = live_.active || (latest_ && showable(*latest_, doc));
+  live_ = {};
   held_ = {};
   stop_seq_ = 0;
-  if (live) worker_->send(cmd::SetLayout{doc.editor.layout()});
+  if (live) layout_seq_ = worker_->send(cmd::SetLayout{doc.editor.layout()});
 }
 
 bool JobControl::keep(Document& doc) {
   const Snapshot* s = shown(doc);
   if (!s || !s->layout || shown_kind(doc) == ResultKind::Kept) return false;
   if (running()) return false;
-  const SnapshotPtr kept = s == held_.snapshot.get() ? held_.snapshot : latest_;
+  const SnapshotPtr kept = shown_snapshot(doc);
   const Layout layout = *s->layout;
   // replace_layout reports the edit (on_change -> layout_edited), which sends the layout to
   // the worker; the kept result is held after that.
+  live_ = {};
   keeping_ = true;
   const EditResult r = doc.editor.replace_layout(layout, "keep optimized layout");
   keeping_ = false;
@@ -197,6 +232,7 @@ bool JobControl::poll(const Document& doc) {
       held_.snapshot = latest_;
     if (latest_->applied_seq >= stop_seq_) stop_seq_ = 0;
   }
+  poll_live(doc);
   const Snapshot* shown_now = shown(doc);
   history_step =
       scrub_index(history_step, shown_now ? int(shown_now->node_history.size()) : 0, history_live);
@@ -272,6 +308,90 @@ std::vector<std::pair<int, bool>> JobControl::pending_arc_pins() const {
   std::vector<std::pair<int, bool>> out;
   for (const auto& p : pending_arcs_) out.emplace_back(p.id, p.pinned);
   return out;
+}
+
+void JobControl::send_live(const Layout& layout, Clock::time_point event) {
+  // Run without node optimization: its first step is the initial solve, and the last.
+  WorkerOptions fixed = options;
+  fixed.node_optimization = false;
+  layout_seq_ = worker_->send(cmd::SetLayout{layout});  // cancels the solve in flight, if any
+  worker_->send(cmd::SetOptions{fixed});
+  live_.inflight_seq = worker_->send(cmd::Step{});
+  live_.inflight_event = event;
+  ++live_stats_.sent;
+}
+
+void JobControl::live_request(const Layout& layout, Clock::time_point event) {
+  ++live_stats_.requests;
+  if (!live_.active) {
+    held_ = {};
+    stop_seq_ = 0;
+    live_ = {};
+    live_.active = true;
+  }
+  live_.invalid = false;
+  if (live_.inflight_seq == 0) {
+    send_live(layout, event);
+  } else {
+    live_.pending = layout;
+    live_.pending_event = event;
+  }
+}
+
+void JobControl::live_invalid() {
+  if (!live_.active) {
+    held_ = {};
+    stop_seq_ = 0;
+    live_ = {};
+    live_.active = true;
+  }
+  live_.invalid = true;
+  live_.pending.reset();
+}
+
+void JobControl::live_release(const Layout& layout, Clock::time_point event) {
+  live_request(layout, event);
+  if (live_.pending) {  // a drag solve is in flight: the release's supersedes it
+    live_.pending.reset();
+    send_live(layout, event);
+  }
+  live_.released = true;
+}
+
+bool JobControl::latest_is_live() const {
+  return latest_ && (live_.active || latest_ == live_result_);
+}
+
+bool JobControl::take_live_released() {
+  const bool released = live_released_;
+  live_released_ = false;
+  return released;
+}
+
+void JobControl::poll_live(const Document& doc) {
+  if (!live_.active || live_.inflight_seq == 0 || latest_->applied_seq < live_.inflight_seq) return;
+  const WorkerStatus status = latest_->status;
+  if (status != WorkerStatus::Finished && status != WorkerStatus::Failed &&
+      status != WorkerStatus::Cancelled)
+    return;  // the Step was taken; its solve is running
+  live_.inflight_seq = 0;
+  if (!live_.invalid) {
+    live_.shown = showable(*latest_, doc) ? latest_ : nullptr;
+    ++live_stats_.shown;
+    live_stats_.latency_ms.push_back(
+        std::chrono::duration<double, std::milli>(Clock::now() - live_.inflight_event).count());
+    live_stats_.last_event = live_.inflight_event;
+  }
+  if (live_.released) {
+    // The solve of the released layout: from now on the worker's result, as after a Run.
+    live_ = {};
+    live_result_ = latest_;
+    live_released_ = true;
+  } else if (live_.pending) {
+    const Layout next = std::move(*live_.pending);
+    live_.pending.reset();
+    send_live(next, live_.pending_event);
+  }
 }
 
 }  // namespace qs::app

@@ -133,6 +133,8 @@ class LayoutEditor {
   std::string undo_label() const;
   std::string redo_label() const;
   std::size_t history_size() const { return history_.size(); }
+  //! Steps that undo can take back (the position in the history).
+  std::size_t undo_position() const { return cursor_; }
 
   //! Called after every committed change (edit, end of drag, undo, redo), e.g. for autosave.
   std::function<void(const Layout&)> on_change;

@@ -31,6 +31,13 @@ int run_editor(int argc, char** argv) {
                  "Frame-time benchmark: render N frames (after 10 warm-up frames), print mean "
                  "and 95th-percentile frame time and fps, and quit")
       ->check(CLI::PositiveNumber);
+  cli.add_option("--bench-drag", options.bench_drag,
+                 "Live-drag benchmark: drag one node with the select tool over N mouse positions "
+                 "(default 60), one per frame, then print the live solves shown per second and "
+                 "the latency from mouse event to solve shown, and quit")
+      ->expected(0, 1)
+      ->default_str("60")
+      ->check(CLI::PositiveNumber);
   cli.add_flag("--show-field", options.show_field, "Start with the cross-field glyph layer on");
   cli.add_option("--samples", options.msaa_samples,
                  "Multisampling (anti-aliasing) samples, 0: off (default: 4, or 0 on software "

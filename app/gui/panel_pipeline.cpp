@@ -1,5 +1,6 @@
-// Pipeline: Run / Pause / Step / Stop, why Run cannot start, the run's state, Keep result /
-// Discard and the step history (the convergence plot is in the Metrics window).
+// Pipeline: Run / Pause / Step / Stop, why Run cannot start, the live solve while dragging, the
+// run's state, Keep result / Discard and the step history (the convergence plot is in the Metrics
+// window).
 #include <algorithm>
 #include <cmath>
 
@@ -67,6 +68,11 @@ void draw_pipeline_panel(AppContext& ctx) {
   tooltip("End the run now; the state reached stays on screen: Keep result or Discard it");
   if (!running && !paused) ImGui::EndDisabled();
   if (!blocker.empty()) text_wrapped("Run: " + blocker);  // also in the status bar
+  ImGui::Checkbox("Live solve while dragging", &editor.live_solve);
+  tooltip(
+      "While you drag a node (select tool) and no run is in progress, solve the layout at every "
+      "position (as Run without node optimization) and show it: the checker, fold-overs, E and "
+      "the structural check follow the drag");
   draw_pipeline_options(ctx);
 
   const Snapshot* s = editor.result();

@@ -26,6 +26,11 @@ render::SceneData build_scene(Editor& editor, const Tools& tools) {
       scene.field_version = result->version;
     }
   }
+  if (doc.editor.dragging()) {
+    // The dragged node follows the mouse; the solve shown (live) may lag behind it.
+    scene.layout = &doc.editor.layout();
+    scene.layout_version = doc.editor.version();
+  }
   const std::uint64_t param = editor.job.param_version(doc);
   scene.param_version = param * 2 + (scene.corner_uv ? 1 : 0);
   for (const auto& issue : doc.validation.issues) {

@@ -362,8 +362,7 @@ void Tools::mouse(const MouseInput& in, Editor& editor, render::Camera& camera,
           drag_ = Drag::Stroke;
           begin_stroke(press_node_, press_, editor, camera, picker);
           add_stroke_sample(at, editor, camera, picker);
-        } else if (tool_ == Tool::Select && press_node_ >= 0 &&
-                   editor.doc.editor.begin_drag(press_node_)) {
+        } else if (tool_ == Tool::Select && press_node_ >= 0 && editor.begin_drag(press_node_)) {
           drag_ = Drag::MoveNode;
           editor.selection = {press_node_, -1};
           ++editor.interaction_version;
@@ -397,11 +396,11 @@ void Tools::mouse(const MouseInput& in, Editor& editor, render::Camera& camera,
     case Drag::MoveNode:
       if (!in.left_down) {
         drag_ = Drag::None;
-        editor.doc.editor.end_drag();
+        editor.end_drag();
         editor.set_status("Moved node " + std::to_string(editor.selection.node));
       } else if (at != last_) {
         if (const auto hit = pick_surface(at, editor, camera, picker)) {
-          const auto r = editor.doc.editor.drag_to(hit->nearest_vertex);
+          const auto r = editor.drag_to(hit->nearest_vertex);
           if (!r) editor.set_status("Cannot move there: " + r.error);
         }
       }
@@ -412,7 +411,7 @@ void Tools::mouse(const MouseInput& in, Editor& editor, render::Camera& camera,
 
 void Tools::escape(Editor& editor) {
   if (editor.doc.editor.dragging()) {
-    editor.doc.editor.cancel_drag();
+    editor.cancel_drag();
     drag_ = Drag::None;
   }
   if (drag_ == Drag::Stroke) {

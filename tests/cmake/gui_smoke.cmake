@@ -66,6 +66,14 @@ if(TARGET gui_sketch_test)
   endif()
 endif()
 
+# gui_drag_test.cpp: live solves while a node is dragged, through the editor's state (GL-free).
+if(TARGET gui_drag_test)
+  foreach(src editor job_control pipeline_job autosave recent_files layout_editor document
+      thread_priority file_browser plot_ticks ui_text sketch_edits symmetry_state field_hints)
+    target_sources(gui_drag_test PRIVATE ${PROJECT_SOURCE_DIR}/app/gui/${src}.cpp)
+  endforeach()
+endif()
+
 if(NOT QS_BUILD_APP)
   return()
 endif()
