@@ -164,8 +164,10 @@ TEST_F(GuiApp, ArcPinnedDuringARunGoesToTheRun) {
 
 // Stop ends the run and keeps the state reached on screen; Keep result adopts it.
 TEST_F(GuiApp, StopKeepsTheStateReachedAndKeepAdoptsIt) {
-  const std::string script = "run\nwait_step 2\nstop\nframes 3\nstate " + p("stopped.json") +
-                             "\nkeep\nframes 2\nstate " + p("kept.json") + "\nquit\n";
+  // After Stop the worker ends the run at its next step: wait for that, not for a frame count.
+  const std::string script = "run\nwait_step 2\nstop\nwait_status cancelled 120\nframes 2\nstate " +
+                             p("stopped.json") + "\nkeep\nframes 2\nstate " + p("kept.json") +
+                             "\nquit\n";
   ASSERT_EQ(run_app({}, script), 0);
   const json stopped = read_json(path("stopped.json"));
   const json kept = read_json(path("kept.json"));
@@ -189,8 +191,10 @@ TEST_F(GuiApp, StopKeepsTheStateReachedAndKeepAdoptsIt) {
 
 // Keep result keeps the energy, the quad mesh and the quad export of a finished run.
 TEST_F(GuiApp, KeepResultKeepsTheEnergyAndTheQuadMesh) {
+  // The worker takes the kept layout on its own time: wait for it, not for a frame count.
   const std::string script = "run\nwait_finished\nframes 2\nstate " + p("finished.json") +
-                             "\nkeep\nframes 3\nstate " + p("kept.json") + "\nquit\n";
+                             "\nkeep\nwait_status idle 120\nframes 2\nstate " + p("kept.json") +
+                             "\nquit\n";
   ASSERT_EQ(run_app({}, script), 0);
   const json finished = read_json(path("finished.json"));
   const json kept = read_json(path("kept.json"));
