@@ -169,7 +169,7 @@ TEST(SymmetricOptimize, SettingsThatMoveSingleNodesAreRefused) {
   NodeOptOptions no;
   auto wrong = std::make_shared<NodeSymmetry>();
   wrong->node_mirror = {0, 1};
-  no.symmetry = wrong;
+  no.moves.symmetry = wrong;
   EXPECT_THROW(optimize_nodes(in.mesh, in.layout, PipelineOptions{}, no), InvalidInputError);
 }
 
