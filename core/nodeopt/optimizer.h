@@ -98,7 +98,13 @@ struct NodeOptTuning {
 struct NodeOptOptions {
   //! The gradient descent (docs/design.md, "Step length"). A descent phase ends when no node
   //! moves (every step shorter than 10⁻⁴ mean edge lengths), after more than 5 halvings of α,
-  //! or when its step budget is used up.
+  //! or when its step budget is used up. Each node's trace stays in its Dijkstra-Voronoi cell
+  //! (docs/design.md, "Straightest geodesics"). A step that raises E after some nodes changed
+  //! their vertex is retried once with those nodes kept on their vertices before α is halved
+  //! ("Retries"); a sliding node whose switch raised E takes half steps from then on, until a
+  //! switch of its own is accepted or a hop sweep starts a new phase (otherwise a node sliding
+  //! along the boundary and an interior node lined up with it can propose the same swap at
+  //! every step).
   struct Descent {
     //! Descent steps (accepted + rejected) before the first hop sweep; a sweep that moves nodes
     //! extends the budget to at least tuning.hop_descent_steps more.
