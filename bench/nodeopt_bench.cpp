@@ -5,9 +5,9 @@
 //
 // default-malloc: glibc's allocator defaults instead of the applications' keep_freed_memory().
 // descent: no hop polish and no fold-over removal after the descent (only the STEPS descent
-// steps are timed in "optimize"); fresh: NodeOptOptions::reuse_field off (a fresh Pipeline per
-// trial with re-routed arcs); parallel:
-// NodeOptOptions::parallel_retry on (two threads); steps: print every step.
+// steps are timed in "optimize"); fresh: NodeOptOptions::Run::reuse_field off (a fresh Pipeline
+// per trial with re-routed arcs); parallel: NodeOptOptions::Run::threads = 3 (the retry without
+// switches beside its trial; otherwise 2); steps: print every step.
 // Times are CPU seconds of the process (CLOCK_PROCESS_CPUTIME_ID: wall time is meaningless
 // on a shared, overloaded machine); run with OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
 // OMP_THREAD_LIMIT=1 so that no spinning helper thread is counted (Debian's CHOLMOD asks for 4
@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
     const int steps = argc > 3 ? std::atoi(argv[3]) : 10;
     const int repeats = argc > 4 ? std::atoi(argv[4]) : 3;
     // Flags after REPEATS: "descent" (no hop polish, no fold-over removal at the end), "fresh"
-    // (NodeOptOptions::reuse_field off: a fresh Pipeline per trial with re-routed arcs).
+    // (NodeOptOptions::Run::reuse_field off: a fresh Pipeline per trial with re-routed arcs).
     // "steps": print every step.
     bool descent_only = false, fresh_trials = false, verbose = false, parallel = false;
     bool keep_memory = true;
@@ -114,14 +114,14 @@ int main(int argc, char** argv) {
       resolve.push_back(cpu_now() - t0);
 
       qs::NodeOptOptions no;
-      no.max_steps = steps;
-      no.reuse_field = !fresh_trials;
-      no.parallel_retry = parallel;
+      no.descent.max_steps = steps;
+      no.run.reuse_field = !fresh_trials;
+      no.run.threads = parallel ? 3 : 2;
       if (descent_only) {
-        no.hop_polish = false;
-        no.stall_gain = 0;  // all STEPS steps, as the 25-step target counts them
-        no.orientation_at_end = false;
-        no.stiffen_at_end = false;
+        no.polish.enabled = false;
+        no.tuning.stall_gain = 0;  // all STEPS steps, as the 25-step target counts them
+        no.folds.orientation = false;
+        no.folds.stiffen = false;
       }
       qs::NodeOptStats stats;
       StepTimer timer;

@@ -24,7 +24,7 @@
 // --hop-min-offset X, --hop-candidates N, --hop-max-evaluations N, --hop-max-failures N,
 // --hop-collective 0|1, --hop-cones 0|1, --hop-cone-rings N, --hop-cone-targets N,
 // --hop-cone-max-failures N, --hop-rounds N, --stall-gain X, --hop-alpha-growth X:
-// NodeOptOptions::hop_* / max_hop_rounds / stall_gain / hop_alpha_growth. A polish without
+// NodeOptTuning::hop_* / max_hop_rounds / stall_gain / hop_alpha_growth. A polish without
 // the cone and collective passes, for comparison: --hop-cones 0 --hop-collective 0
 // --hop-min-offset 0.25 --hop-max-evaluations 16 --hop-max-failures 0.
 //
@@ -180,32 +180,32 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--discrete-cap"))
       discrete_cap = std::atof(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--hop-cones"))
-      hop.hop_cones = std::atoi(argv[i + 1]) != 0;
+      hop.tuning.hop_cones = std::atoi(argv[i + 1]) != 0;
     else if (!std::strcmp(argv[i], "--hop-max-evaluations"))
-      hop.hop_max_evaluations = std::atoi(argv[i + 1]);
+      hop.tuning.hop_max_evaluations = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--hop-min-offset"))
-      hop.hop_min_offset = std::atof(argv[i + 1]);
+      hop.tuning.hop_min_offset = std::atof(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--hop-candidates"))
-      hop.hop_candidates = std::atoi(argv[i + 1]);
+      hop.tuning.hop_candidates = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--hop-max-failures"))
-      hop.hop_max_failures = std::atoi(argv[i + 1]);
+      hop.tuning.hop_max_failures = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--hop-collective"))
-      hop.hop_collective = std::atoi(argv[i + 1]) != 0;
+      hop.tuning.hop_collective = std::atoi(argv[i + 1]) != 0;
     else if (!std::strcmp(argv[i], "--hop-cone-rings"))
-      hop.hop_cone_rings = std::atoi(argv[i + 1]);
+      hop.tuning.hop_cone_rings = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--hop-cone-targets"))
-      hop.hop_cone_targets = std::atoi(argv[i + 1]);
+      hop.tuning.hop_cone_targets = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--hop-cone-max-failures"))
-      hop.hop_cone_max_failures = std::atoi(argv[i + 1]);
+      hop.tuning.hop_cone_max_failures = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--stall-gain"))
-      hop.stall_gain = std::atof(argv[i + 1]);
+      hop.tuning.stall_gain = std::atof(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--hop-alpha-growth"))
-      hop.hop_alpha_growth = std::atof(argv[i + 1]);
+      hop.tuning.hop_alpha_growth = std::atof(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--gradient"))
-      hop.gradient = !std::strcmp(argv[i + 1], "exact") ? qs::GradientMethod::Exact
-                                                        : qs::GradientMethod::Estimator;
+      hop.descent.gradient = !std::strcmp(argv[i + 1], "exact") ? qs::GradientMethod::Exact
+                                                                : qs::GradientMethod::Estimator;
     else if (!std::strcmp(argv[i], "--hop-rounds"))
-      hop.max_hop_rounds = std::atoi(argv[i + 1]);
+      hop.tuning.max_hop_rounds = std::atoi(argv[i + 1]);
     else {
       std::fprintf(stderr,
                    "usage: qs_relocation_bench [--rings K] [--seeds N] [--max-steps S] "
@@ -267,18 +267,17 @@ int main(int argc, char** argv) {
         }
         const qs::PipelineOptions options;
         qs::NodeOptOptions no = hop;
-        no.max_steps = max_steps;
+        no.descent.max_steps = max_steps;
         // CPU time compares the methods: both solve one candidate at a time (the second threads
-        // of parallel_hops and DiscreteOptions::parallel shorten the wall time but add CPU, most
-        // on small meshes: the discrete ellipsoid run 1.4 s → 1.8 s).
-        no.parallel_hops = false;
-        no.parallel_fallback = false;
+        // of run.threads ≥ 2 and DiscreteOptions::parallel shorten the wall time but add CPU,
+        // most on small meshes: the discrete ellipsoid run 1.4 s → 1.8 s).
+        no.run.threads = 1;
         if (hop_all) {
-          no.hop_min_offset = 0;
-          no.hop_candidates = 0;
-          no.hop_min_cos = -1;
-          no.hop_max_evaluations = 1 << 20;
-          no.hop_max_failures = 0;
+          no.tuning.hop_min_offset = 0;
+          no.tuning.hop_candidates = 0;
+          no.tuning.hop_min_cos = -1;
+          no.tuning.hop_max_evaluations = 1 << 20;
+          no.tuning.hop_max_failures = 0;
         }
         Trace cont;
         cont.verbose = verbose;
@@ -298,7 +297,7 @@ int main(int argc, char** argv) {
         }
 
         qs::NodeOptOptions plain = no;
-        plain.hop_polish = false;
+        plain.polish.enabled = false;
         Trace desc;
         desc.start = cpu_now();
         const qs::NodeOptResult rd = qs::optimize_nodes(c.mesh, start, options, plain, &desc);

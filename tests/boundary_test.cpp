@@ -267,7 +267,7 @@ TEST(Boundary, BoundaryNodesSlideOntoTheSquaresCorners) {
       EXPECT_NEAR(p[0] / step, std::round(p[0] / step), 1e-12) << "node " << i;
       EXPECT_NEAR(p[1] / step, std::round(p[1] / step), 1e-12) << "node " << i;
     }
-    no.slide_on_curves = false;
+    no.moves.slide_on_curves = false;
     const NodeOptResult fixed = optimize_nodes(d.mesh, layout, options, no);
     EXPECT_GT(fixed.E_final, 0.1 * fixed.E_init);
     std::printf("[stat] shift %d: E %.6g -> %.3g (sliding), %.6g (not sliding)\n", shift, r.E_init,

@@ -386,7 +386,7 @@ TEST(Cli, ThreadTimingNeverChangesTheResult) {
 
 // --keep-nodes-apart is passed to the node optimization and recorded (the report's
 // node_optimization.keep_nodes_apart; no retry then), and it excludes --no-keep-nodes-apart.
-// NodeOptOptions::keep_nodes_apart itself is tested in orientation_displaced_test.cpp, the
+// NodeOptOptions::Moves::keep_nodes_apart itself is tested in orientation_displaced_test.cpp, the
 // retry rules in retry_test.cpp.
 TEST(Cli, KeepNodesApartIsPassedOnAndRecorded) {
   const std::string dir = test::temp_dir("cli_keep_apart");

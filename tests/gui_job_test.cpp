@@ -117,7 +117,7 @@ TEST(GuiJob, DisplayedStepMatchesFreshSolve) {
   const double E = fresh.compute_parameterization().energy;
   // The optimizer's last solve may add the orientation constraints (when the plain one folds).
   qs::PipelineOptions oriented = po;
-  oriented.param.orientation = qs::NodeOptOptions{}.orientation;
+  oriented.param.orientation = qs::OrientationOptions{};
   oriented.param.orientation.enabled = true;
   qs::Pipeline fresh_oriented(s->exports->mesh, layout, oriented);
   const double E_oriented = fresh_oriented.compute_parameterization().energy;
@@ -303,7 +303,7 @@ TEST(GuiJob, RunEndsWhereTheOptimizerEnds) {
 
   OptimizeSettings descent = optimize_settings(options);
   NodeOptOptions no = node_options(descent);
-  no.hop_polish = false;
+  no.polish.enabled = false;
   const NodeOptResult d = optimize_nodes(*ex.mesh, ex.layout, pipeline_options(descent), no);
   std::printf("[stat] editor run: %d steps, E %.6g (descent alone %.6g)\n", s->iteration,
               s->metrics.E, d.E_final);

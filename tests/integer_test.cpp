@@ -125,7 +125,7 @@ TEST(IntegerSizes, ContradictingLengthsNameTheArcs) {
   try {
     fixed.compute_parameterization();
     FAIL() << "incompatible lengths were accepted";
-  } catch (const InvalidInputError& e) {
+  } catch (const InfeasibleLayoutError& e) {
     EXPECT_NE(std::string(e.what()).find("fixed length"), std::string::npos) << e.what();
   }
 }

@@ -60,7 +60,7 @@ struct SlideRun {
 
 SlideRun optimize(const TriMesh& mesh, const Layout& layout, bool slide) {
   NodeOptOptions no;
-  no.slide_on_curves = slide;
+  no.moves.slide_on_curves = slide;
   SlideRun run;
   run.result = optimize_nodes(mesh, layout, PipelineOptions{}, no);
   Pipeline check(run.result.mesh, run.result.layout);
@@ -159,8 +159,8 @@ TEST(CurveSliding, FeatureNodeSlidesAlongTheFeature) {
   }
 }
 
-// NodeOptOptions::sharp_edges_as_curves on the genus-2 polycube with nodes displaced one ring
-// from its corners: the polycube's edges are sharp curves, nodes on them slide along them, the
+// NodeOptOptions::Moves::sharp_edges_as_curves on the genus-2 polycube with nodes displaced one
+// ring from its corners: the polycube's edges are sharp curves, nodes on them slide along them, the
 // others step onto them only at a vertex's place. Every node ends on its corner and no vertex
 // on a sharp edge leaves the polycube's edge lines.
 TEST(CurveSliding, SharpEdgesKeepTheirShape) {
@@ -190,7 +190,7 @@ TEST(CurveSliding, SharpEdgesKeepTheirShape) {
   };
   auto run = [&](bool keep, int& off, int& sliding) {
     NodeOptOptions no;
-    no.sharp_edges_as_curves = keep;
+    no.moves.sharp_edges_as_curves = keep;
     NodeOptimizer opt(poly.mesh, start, PipelineOptions{}, no);
     off = 0;
     while (opt.step()) off += off_lines(opt.mesh());

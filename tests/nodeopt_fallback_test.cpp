@@ -61,11 +61,11 @@ OptimizedCase optimize_case(int stiffening_iterations) {
   const auto cs = test::cube_sphere(8, Vec3(1.3, 1, 0.75));
   const Layout start = test::displace_nodes(cs.mesh, cs.layout, 4, 7);
   NodeOptOptions no;
-  no.max_steps = 4;
-  no.hop_polish = false;  // no pre-polish state: only the fewest-fold-over fallback
-  no.orientation_at_end = false;
-  no.stiffen_at_end = true;
-  no.stiffening.max_iterations = stiffening_iterations;
+  no.descent.max_steps = 4;
+  no.polish.enabled = false;  // no pre-polish state: only the fewest-fold-over fallback
+  no.folds.orientation = false;
+  no.folds.stiffen = true;
+  no.tuning.stiffening.max_iterations = stiffening_iterations;
   OptimizedCase run;
   run.result = optimize_nodes(cs.mesh, start, PipelineOptions{}, no);
   run.min_accepted_folds = run.result.foldovers_init;

@@ -38,7 +38,7 @@ bool same(const ArcState& a, const ArcState& b) {
 
 NodeOptOptions few_steps() {
   NodeOptOptions no;
-  no.max_steps = 8;
+  no.descent.max_steps = 8;
   return no;
 }
 

@@ -282,8 +282,8 @@ TEST(NodeOptimizer, DescendsOnPerturbedEllipsoid) {
 TEST(NodeOptimizer, HopPolishReturnsConsistentState) {
   const auto in = test::cube_sphere(8);
   NodeOptOptions no;
-  no.orientation_at_end = false;
-  no.stiffen_at_end = false;
+  no.folds.orientation = false;
+  no.folds.stiffen = false;
   int polished = 0;
   for (int seed : {6, 7, 8}) {
     const Layout start = test::displace_nodes(in.mesh, in.layout, 4, seed);
@@ -326,8 +326,8 @@ TEST(NodeOptimizer, DescentAfterHopsRestartsNearTheLastStepSize) {
   const auto in = test::ellipsoid_example();
   for (double growth : {2.0, 0.0}) {
     NodeOptOptions no;
-    no.hop_alpha_growth = growth;
-    no.parallel_hops = false;
+    no.tuning.hop_alpha_growth = growth;
+    no.run.threads = 1;
     Recorder rec;
     const NodeOptResult r = optimize_nodes(in.mesh, in.layout, PipelineOptions{}, no, &rec);
     int restarts = 0;
@@ -337,7 +337,8 @@ TEST(NodeOptimizer, DescentAfterHopsRestartsNearTheLastStepSize) {
       if (s.phase == "descent" && s.accepted) last_accepted = s.step_size;
       if (s.phase != "hop" || !s.accepted || rec.steps[i + 1].phase != "descent") continue;
       ASSERT_GT(last_accepted, 0);
-      const double expected = growth > 0 ? std::min(no.alpha, growth * last_accepted) : no.alpha;
+      const double expected =
+          growth > 0 ? std::min(no.descent.alpha, growth * last_accepted) : no.descent.alpha;
       EXPECT_DOUBLE_EQ(rec.steps[i + 1].step_size, expected);
       ++restarts;
     }
@@ -348,34 +349,30 @@ TEST(NodeOptimizer, DescentAfterHopsRestartsNearTheLastStepSize) {
   }
 }
 
-// reuse_hop_solve: a sweep that kept hops takes its best candidate's solve as the new state
-// instead of solving that state again: the same trajectory (every reported E bit for bit), one
-// re-layout less per such sweep, with and without the second thread.
+// A sweep that kept hops takes its best candidate's solve as the new state instead of solving
+// that state again, on one thread and on two: every such sweep reuses a solve, and both give the
+// same trajectory (every reported E bit for bit).
 TEST(NodeOptimizer, HopSweepKeepsItsBestCandidatesSolve) {
   const auto in = test::ellipsoid_example();
-  for (bool parallel : {false, true}) {
-    SCOPED_TRACE(parallel ? "parallel hops" : "one at a time");
-    std::vector<double> E[2];
-    NodeOptStats stats[2];
+  std::vector<double> E[2];
+  for (int threads : {1, 2}) {
+    SCOPED_TRACE(threads == 2 ? "two threads" : "one thread");
+    NodeOptOptions no;
+    no.run.threads = threads;
+    NodeOptStats stats;
+    Recorder rec;
+    const NodeOptResult r =
+        optimize_nodes(in.mesh, in.layout, PipelineOptions{}, no, &rec, nullptr, &stats);
     int kept_sweeps = 0;
-    for (int reuse = 0; reuse < 2; ++reuse) {
-      NodeOptOptions no;
-      no.parallel_hops = parallel;
-      no.reuse_hop_solve = reuse != 0;
-      Recorder rec;
-      const NodeOptResult r =
-          optimize_nodes(in.mesh, in.layout, PipelineOptions{}, no, &rec, nullptr, &stats[reuse]);
-      for (const StepReport& s : rec.steps) E[reuse].push_back(s.E);
-      E[reuse].push_back(r.E_final);
-      if (reuse)
-        for (const StepReport& s : rec.steps) kept_sweeps += s.phase == "hop" && s.accepted;
+    for (const StepReport& s : rec.steps) {
+      E[threads - 1].push_back(s.E);
+      kept_sweeps += s.phase == "hop" && s.accepted;
     }
+    E[threads - 1].push_back(r.E_final);
     ASSERT_GT(kept_sweeps, 0) << "no sweep kept hops";
-    EXPECT_EQ(E[1], E[0]);
-    EXPECT_EQ(stats[0].reused_hop_solves, 0);
-    EXPECT_EQ(stats[1].reused_hop_solves, kept_sweeps);
-    EXPECT_EQ(stats[0].relayouts - stats[1].relayouts, kept_sweeps);
+    EXPECT_EQ(stats.reused_hop_solves, kept_sweeps);
   }
+  EXPECT_EQ(E[1], E[0]);
 }
 
 // stall_gain: a descent phase ends (the hop sweep follows) after stall_steps accepted steps in a
@@ -383,9 +380,9 @@ TEST(NodeOptimizer, HopSweepKeepsItsBestCandidatesSolve) {
 TEST(NodeOptimizer, StalledDescentEndsThePhase) {
   const auto in = test::ellipsoid_example();
   NodeOptOptions no;
-  no.stall_gain = 1e-3;
-  no.stall_steps = 2;
-  no.parallel_hops = false;
+  no.tuning.stall_gain = 1e-3;
+  no.tuning.stall_steps = 2;
+  no.run.threads = 1;
   Recorder rec;
   optimize_nodes(in.mesh, in.layout, PipelineOptions{}, no, &rec);
   double E = rec.steps.at(0).E;
@@ -393,7 +390,7 @@ TEST(NodeOptimizer, StalledDescentEndsThePhase) {
   for (const StepReport& s : rec.steps) {
     if (s.phase == "hop") {
       if (phases_checked == 0) {  // the first phase ended by the stall rule
-        EXPECT_EQ(small, no.stall_steps);
+        EXPECT_EQ(small, no.tuning.stall_steps);
       }
       ++phases_checked;
       small = 0;
@@ -401,8 +398,8 @@ TEST(NodeOptimizer, StalledDescentEndsThePhase) {
       continue;
     }
     if (s.phase != "descent" || !s.accepted) continue;
-    EXPECT_LT(small, no.stall_steps) << "step " << s.step << " ran after the phase stalled";
-    small = E - s.E < no.stall_gain * E ? small + 1 : 0;
+    EXPECT_LT(small, no.tuning.stall_steps) << "step " << s.step << " ran after the phase stalled";
+    small = E - s.E < no.tuning.stall_gain * E ? small + 1 : 0;
     E = s.E;
   }
   EXPECT_GT(phases_checked, 0);
@@ -485,8 +482,8 @@ TEST(NodeOptimizer, ExactGradientDescends) {
   const auto in = test::cube_sphere(6);
   const Layout start = test::displace_nodes(in.mesh, in.layout, 1, 3);
   NodeOptOptions no;
-  no.gradient = GradientMethod::Exact;
-  no.max_steps = 4;
+  no.descent.gradient = GradientMethod::Exact;
+  no.descent.max_steps = 4;
   Recorder rec;
   const NodeOptResult r = optimize_nodes(in.mesh, start, PipelineOptions{}, no, &rec);
   std::printf("[stat] exact gradient: E %.6g -> %.6g, %d steps, %.2f s\n", r.E_init, r.E_final,
@@ -510,7 +507,7 @@ TEST(NodeOptimizer, CancelsBetweenSolves) {
                Cancelled);
 }
 
-// NodeOptOptions::stop (optimize --time-limit) ends the node movement with the state reached:
+// NodeOptOptions::Run::stop (optimize --time-limit) ends the node movement with the state reached:
 // the same first steps as the whole run, nothing moved after the stop, and the fold-over removal
 // still runs. The bundled sketch folds with its initial node positions.
 TEST(NodeOptimizer, StopEndsTheMovementAndTheFoldoverRemovalStillRuns) {
@@ -528,7 +525,7 @@ TEST(NodeOptimizer, StopEndsTheMovementAndTheFoldoverRemovalStillRuns) {
 
   // Stopped at once: the initial state, unfolded by the orientation constraints.
   NodeOptOptions at_once;
-  at_once.stop = [] { return true; };
+  at_once.run.stop = [] { return true; };
   Recorder rec0;
   const NodeOptResult r0 = optimize_nodes(mesh, layout, PipelineOptions{}, at_once, &rec0);
   EXPECT_TRUE(r0.stopped);
@@ -543,7 +540,7 @@ TEST(NodeOptimizer, StopEndsTheMovementAndTheFoldoverRemovalStillRuns) {
   // fold-over removal.
   NodeOptOptions after3;
   Recorder rec3;
-  after3.stop = [&] { return descent_steps(rec3) >= 3; };
+  after3.run.stop = [&] { return descent_steps(rec3) >= 3; };
   const NodeOptResult r3 = optimize_nodes(mesh, layout, PipelineOptions{}, after3, &rec3);
   EXPECT_TRUE(r3.stopped);
   EXPECT_EQ(r3.steps, 3);
@@ -772,8 +769,8 @@ TEST(NodeOptimizer, ReuseMatchesFreshPipelines) {
   const Layout start = test::displace_nodes(in.mesh, in.layout, 2, 5);
   PipelineOptions options;
   NodeOptOptions no;
-  no.reuse_field = true;  // off by default (optimizer.h)
-  no.max_steps = 8;
+  no.run.reuse_field = true;  // the default (optimizer.h), set for the record
+  no.descent.max_steps = 8;
   NodeOptStats stats;
   Recorder rec;
   const NodeOptResult r = optimize_nodes(in.mesh, start, options, no, &rec, nullptr, &stats);
@@ -798,7 +795,7 @@ TEST(NodeOptimizer, ReuseMatchesFreshPipelines) {
     EXPECT_NEAR(energy_of(*r.pipeline), E_fresh, 1e-9 * E_fresh);
     // Warm start from the returned Pipeline: the initial E is the same without a fresh solve.
     NodeOptOptions one = no;
-    one.max_steps = 1;
+    one.descent.max_steps = 1;
     NodeOptStats warm;
     const NodeOptResult r2 =
         optimize_nodes(r.mesh, r.layout, options, one, nullptr, r.pipeline, &warm);
@@ -807,7 +804,7 @@ TEST(NodeOptimizer, ReuseMatchesFreshPipelines) {
   }
   // A Pipeline of another state is not taken as the start.
   NodeOptOptions one = no;
-  one.max_steps = 1;
+  one.descent.max_steps = 1;
   NodeOptStats other;
   auto stale = std::make_shared<Pipeline>(in.mesh, in.layout, options);
   stale->compute_parameterization();
@@ -824,9 +821,9 @@ TEST(NodeOptimizer, ReuseMatchesFreshPipelinesOnExample) {
   Layout layout = load_layout(dir + "ellipsoid.layout.json", mesh);
   PipelineOptions options;
   NodeOptOptions one;
-  one.max_steps = 1;
-  one.hop_polish = false;  // as the editor: one descent step per call
-  one.stiffen_at_end = false;
+  one.descent.max_steps = 1;
+  one.polish.enabled = false;  // as the editor: one descent step per call
+  one.folds.stiffen = false;
   std::shared_ptr<Pipeline> warm;
   for (int step = 0; step < 4; ++step) {
     NodeOptStats stats;
@@ -845,7 +842,7 @@ TEST(NodeOptimizer, ReuseMatchesFreshPipelinesOnExample) {
     mesh = r.mesh;
     layout = r.layout;
     warm = r.descent_pipeline;
-    one.alpha *= r.accepted ? 1 : 0.5;
+    one.descent.alpha *= r.accepted ? 1 : 0.5;
     if (step > 0) {
       EXPECT_TRUE(stats.warm_start);
     }
@@ -857,17 +854,17 @@ NodeOptResult optimize_example(NodeOptOptions no, NodeOptStats* stats) {
   const std::string dir = std::string(QS_ASSETS_DIR) + "/example/";
   const TriMesh mesh = test::load_mesh(dir + "ellipsoid.obj");
   const Layout layout = load_layout(dir + "ellipsoid.layout.json", mesh);
-  no.orientation_at_end = false;
-  no.stiffen_at_end = false;
+  no.folds.orientation = false;
+  no.folds.stiffen = false;
   return optimize_nodes(mesh, layout, PipelineOptions{}, no, nullptr, nullptr, stats);
 }
 
-// The switch tabu (NodeOptOptions::switch_tabu) rejects trials that mostly repeat the switches
+// The switch tabu (NodeOptTuning::switch_tabu) rejects trials that mostly repeat the switches
 // of one rejected at the same α without solving them: on the bundled example it skips such
 // trials, so fewer re-layouts are solved, and the descent still ends at least as low.
 TEST(NodeOptimizer, SwitchTabuSkipsRepeatedRejectedSwitches) {
   NodeOptOptions without;
-  without.switch_tabu = false;
+  without.tuning.switch_tabu = false;
   NodeOptStats s_with, s_without;
   const NodeOptResult r_with = optimize_example(NodeOptOptions{}, &s_with);
   const NodeOptResult r_without = optimize_example(without, &s_without);
@@ -976,8 +973,8 @@ TEST(NodeOptimizer, HopPolishReturnsPolycubeNodesToCorners) {
   Recorder rec;
   const NodeOptResult r = optimize_nodes(poly.mesh, start, PipelineOptions{}, {}, &rec);
   NodeOptOptions plain;
-  plain.hop_cones = false;
-  plain.hop_collective = false;
+  plain.tuning.hop_cones = false;
+  plain.tuning.hop_collective = false;
   const NodeOptResult p = optimize_nodes(poly.mesh, start, PipelineOptions{}, plain);
   std::printf(
       "[stat] polycube seed 1: E %.6g -> %.6g (%d hop sweeps, %d moves); without the cone and "
@@ -996,11 +993,11 @@ TEST(NodeOptimizer, HopPolishReturnsPolycubeNodesToCorners) {
   }
 }
 
-// parallel_retry solves a re-layout on a second thread beside its retry without switches: the
-// same trajectory as the sequential order, step for step.
+// With run.threads ≥ 3 a re-layout is solved on a second thread beside its retry without
+// switches: the same trajectory as the sequential order (two threads: hops only), step for step.
 TEST(NodeOptimizer, ParallelRetryGivesTheSequentialTrajectory) {
   NodeOptOptions parallel;
-  parallel.parallel_retry = true;
+  parallel.run.threads = 3;
   NodeOptStats s_seq, s_par;
   const NodeOptResult a = optimize_example(NodeOptOptions{}, &s_seq);
   const NodeOptResult b = optimize_example(parallel, &s_par);
@@ -1021,17 +1018,18 @@ TEST(NodeOptimizer, UntanglingIsTheLastResort) {
   const auto in = test::cube_sphere(8, Vec3(1.3, 1, 0.75));
   const Layout start = test::displace_nodes(in.mesh, in.layout, 4, 6);
   NodeOptOptions no;
-  no.max_steps = 3;
-  no.hop_descent_steps = 0;
-  no.max_hop_rounds = 1;
-  no.orientation.max_iterations = 1;
-  no.stiffen_at_end = false;
-  no.orientation.untangle = false;
-  const NodeOptResult plain = optimize_nodes(in.mesh, start, PipelineOptions{}, no);
+  no.descent.max_steps = 3;
+  no.tuning.hop_descent_steps = 0;
+  no.tuning.max_hop_rounds = 1;
+  no.folds.stiffen = false;
+  PipelineOptions options;  // the options of the fold-over removal's constrained solves
+  options.param.orientation.max_iterations = 1;
+  options.param.orientation.untangle = false;
+  const NodeOptResult plain = optimize_nodes(in.mesh, start, options, no);
   ASSERT_GT(plain.foldovers_final, 0) << "the case must keep fold-overs without the untangling";
   EXPECT_FALSE(plain.untangled);
-  no.orientation.untangle = true;
-  const NodeOptResult untangled = optimize_nodes(in.mesh, start, PipelineOptions{}, no);
+  options.param.orientation.untangle = true;
+  const NodeOptResult untangled = optimize_nodes(in.mesh, start, options, no);
   std::printf("[stat] cube-sphere seed 6: %d fold-overs left, untangled %d (E %.6g -> %.6g)\n",
               plain.foldovers_final, untangled.foldovers_final, plain.E_final, untangled.E_final);
   EXPECT_TRUE(untangled.untangled);
@@ -1050,31 +1048,33 @@ TEST(NodeOptimizer, UntanglingIsTheLastResort) {
   EXPECT_EQ(untangled.reports.back().foldovers, untangled.foldovers_final);
 }
 
-// parallel_fallback solves the state before the polish beside the final state's fold-over
+// With two threads the state before the polish is solved beside the final state's fold-over
 // removal: the result, the reports streamed to the observer and their order are those of the
-// sequential order. Orientation with one interior-point iteration leaves fold-overs at the final
-// state, so the fallback is used (seeds 6 and 8 take its result, seed 7 keeps the final state).
+// sequential order (one thread). Orientation with one interior-point iteration leaves fold-overs at
+// the final state, so the fallback is used (seeds 6 and 8 take its result, seed 7 keeps the final
+// state).
 TEST(NodeOptimizer, ParallelFallbackGivesTheSequentialResult) {
   const auto in = test::cube_sphere(8, Vec3(1.3, 1, 0.75));
   int used = 0, reverted = 0;
   for (int seed : {6, 7, 8}) {
     const Layout start = test::displace_nodes(in.mesh, in.layout, 4, seed);
     NodeOptOptions sequential;
-    sequential.max_steps = 3;  // fold-overs left when the polish ends the run
-    sequential.hop_descent_steps = 0;
-    sequential.max_hop_rounds = 1;
-    sequential.orientation.max_iterations = 1;
-    sequential.orientation.untangle = false;  // the fold-overs must stay
-    sequential.stiffen_at_end = false;
-    sequential.parallel_fallback = false;
+    sequential.descent.max_steps = 3;  // fold-overs left when the polish ends the run
+    sequential.tuning.hop_descent_steps = 0;
+    sequential.tuning.max_hop_rounds = 1;
+    sequential.folds.stiffen = false;
+    sequential.run.threads = 1;
     NodeOptOptions parallel = sequential;
-    parallel.parallel_fallback = true;
+    parallel.run.threads = 2;
+    PipelineOptions options;
+    options.param.orientation.max_iterations = 1;
+    options.param.orientation.untangle = false;  // the fold-overs must stay
     Recorder rec_a, rec_b;
     NodeOptStats s_a, s_b;
     const NodeOptResult a =
-        optimize_nodes(in.mesh, start, PipelineOptions{}, sequential, &rec_a, nullptr, &s_a);
+        optimize_nodes(in.mesh, start, options, sequential, &rec_a, nullptr, &s_a);
     const NodeOptResult b =
-        optimize_nodes(in.mesh, start, PipelineOptions{}, parallel, &rec_b, nullptr, &s_b);
+        optimize_nodes(in.mesh, start, options, parallel, &rec_b, nullptr, &s_b);
     std::printf("[stat] seed %d: hops %d, fold-overs %d -> %d, polish reverted %d, used %d\n", seed,
                 a.hops, a.foldovers_descent, a.foldovers_final, a.polish_reverted,
                 s_b.parallel_fallbacks);
@@ -1094,15 +1094,16 @@ TEST(NodeOptimizer, ParallelFallbackGivesTheSequentialResult) {
   }
 }
 
-// parallel_hops solves a node's hop candidates two at a time: the same sweeps, the same kept
-// hops and the same trajectory as one at a time, step for step (the example's polish keeps
-// hops, so the sweeps change the state).
+// Two threads solve a node's hop candidates two at a time: the same sweeps, the same kept hops
+// and the same trajectory as one thread, step for step (the example's polish keeps hops, so the
+// sweeps change the state).
 TEST(NodeOptimizer, ParallelHopsGiveTheSequentialTrajectory) {
-  NodeOptOptions sequential;
-  sequential.parallel_hops = false;
+  NodeOptOptions sequential, parallel;
+  sequential.run.threads = 1;
+  parallel.run.threads = 2;
   NodeOptStats s_seq, s_par;
   const NodeOptResult a = optimize_example(sequential, &s_seq);
-  const NodeOptResult b = optimize_example(NodeOptOptions{}, &s_par);
+  const NodeOptResult b = optimize_example(parallel, &s_par);
   EXPECT_EQ(s_seq.parallel_hop_jobs, 0);
   if (std::thread::hardware_concurrency() >= 2) {
     EXPECT_GT(s_par.parallel_hop_jobs, 0);

@@ -46,9 +46,8 @@ TEST(OrientationDisplaced, DefaultSectorsUnfoldDisplacedSpot) {
   for (int i = 0; i < 2; ++i) {
     PipelineOptions options;
     ASSERT_FALSE(options.param.sizing.enabled);
-    NodeOptOptions no;
-    no.orientation.sector_frame = frames[i];
-    r[i] = optimize_nodes(imp.mesh, displaced, options, no);
+    options.param.orientation.sector_frame = frames[i];
+    r[i] = optimize_nodes(imp.mesh, displaced, options, NodeOptOptions{});
     std::printf(
         "[stat] displaced spot, %s sectors: fold-overs %d -> %d -> %d (%s, %d faces, "
         "%d rounds, %.3f s) E %.6g -> %.6g -> %.6g %s\n",
@@ -83,7 +82,7 @@ int new_node_pairs_on_an_edge(const TriMesh& mesh, const Layout& before, const L
   return pairs;
 }
 
-// NodeOptOptions::keep_nodes_apart: on the displaced spot (about 3 edges per patch side) the
+// NodeOptOptions::Moves::keep_nodes_apart: on the displaced spot (about 3 edges per patch side) the
 // default descent and hop polish carry nodes next to other nodes; with the option no node that
 // moved to another vertex ends on another node's 1-ring (nodes displaced next to each other
 // may stay), and the descent still lowers E.
@@ -96,9 +95,9 @@ TEST(OrientationDisplaced, KeepNodesApartLeavesNoNewNodesOnATriangle) {
   NodeOptResult r[2];
   for (int apart = 0; apart < 2; ++apart) {
     NodeOptOptions no;
-    no.keep_nodes_apart = apart == 1;
-    no.orientation_at_end = false;  // the descent and the hop polish only
-    no.stiffen_at_end = false;
+    no.moves.keep_nodes_apart = apart == 1;
+    no.folds.orientation = false;  // the descent and the hop polish only
+    no.folds.stiffen = false;
     r[apart] = optimize_nodes(imp.mesh, displaced, PipelineOptions{}, no);
     pairs[apart] = new_node_pairs_on_an_edge(imp.mesh, displaced, r[apart].layout);
     std::printf(
@@ -111,7 +110,7 @@ TEST(OrientationDisplaced, KeepNodesApartLeavesNoNewNodesOnATriangle) {
   EXPECT_LT(r[1].E_descent, r[1].E_init);
 }
 
-// NodeOptOptions::initial_fallback: a sketch whose own nodes embed is never handed back folded.
+// NodeOptTuning::initial_fallback: a sketch whose own nodes embed is never handed back folded.
 // The orientation-constrained solves at the moved states (orientation_at_moved_states),
 // stiffening and the untangling are switched off, so that only the initial state's
 // constrained solve can remove what the descent leaves. Asserted: with the fallback the result
@@ -132,12 +131,13 @@ TEST(OrientationDisplaced, InitialStateIsTheLastFallback) {
   NodeOptResult r[2];
   for (int fallback = 0; fallback < 2; ++fallback) {
     NodeOptOptions no;
-    no.keep_nodes_apart = true;
-    no.initial_fallback = fallback == 1;
-    no.orientation_at_moved_states = false;
-    no.orientation.untangle = false;
-    no.stiffen_at_end = false;
-    r[fallback] = optimize_nodes(imp.mesh, displaced, PipelineOptions{}, no);
+    no.moves.keep_nodes_apart = true;
+    no.tuning.initial_fallback = fallback == 1;
+    no.tuning.orientation_at_moved_states = false;
+    no.folds.stiffen = false;
+    PipelineOptions options;
+    options.param.orientation.untangle = false;
+    r[fallback] = optimize_nodes(imp.mesh, displaced, options, no);
     int attempts = 0;
     for (const StepReport& s : r[fallback].reports) attempts += s.phase == "orientation";
     std::printf(
@@ -167,7 +167,7 @@ TEST(OrientationDisplaced, InitialStateIsTheLastFallback) {
   }
 }
 
-// NodeOptOptions::separate_crowded_nodes: the nodes perturb put next to each other are moved
+// NodeOptOptions::Moves::separate_crowded_nodes: the nodes perturb put next to each other are moved
 // apart before the descent (the run starts from another layout), and the run ends embedded.
 TEST(OrientationDisplaced, SeparatedCrowdedNodesEmbed) {
   const std::string dir = test::shared_meshes_dir();
@@ -175,8 +175,8 @@ TEST(OrientationDisplaced, SeparatedCrowdedNodesEmbed) {
   const QuadImportResult imp = import_spot(dir);
   const Layout displaced = displace(imp);
   NodeOptOptions no;
-  no.keep_nodes_apart = true;
-  no.separate_crowded_nodes = true;
+  no.moves.keep_nodes_apart = true;
+  no.moves.separate_crowded_nodes = true;
   const NodeOptResult sep = optimize_nodes(imp.mesh, displaced, PipelineOptions{}, no);
   std::printf(
       "[stat] displaced spot, nodes kept apart and %zu of %d crowded nodes moved apart: "

@@ -441,7 +441,8 @@ TEST(OrientationNodeOpt, FoldsLeftByTheDescentAreRemovedByConstraintsNotStiffeni
   const auto in = test::cube_sphere(6);
   const Layout layout = displaced(in, 4, 1);
   NodeOptOptions no;
-  no.max_steps = 0;  // no descent: the fold-overs of the displaced layout reach the last solve
+  no.descent.max_steps =
+      0;  // no descent: the fold-overs of the displaced layout reach the last solve
   const NodeOptResult r = optimize_nodes(in.mesh, layout, PipelineOptions{}, no);
   std::printf("[stat] node optimizer: fold-overs %d -> %d (%s), E %.6g -> %.6g\n",
               r.foldovers_descent, r.foldovers_final,
@@ -468,13 +469,36 @@ TEST(OrientationNodeOpt, FoldsLeftByTheDescentAreRemovedByConstraintsNotStiffeni
   ASSERT_TRUE(r.pipeline && r.pipeline->parameterization());
   EXPECT_EQ(r.pipeline->parameterization()->foldovers, 0);
   // Disabled: no constrained solve; stiffening alone takes over.
-  no.orientation_at_end = false;
+  no.folds.orientation = false;
   const NodeOptResult s = optimize_nodes(in.mesh, layout, PipelineOptions{}, no);
   EXPECT_FALSE(s.orientation.ran);
   EXPECT_FALSE(s.orientation_constraints);
   EXPECT_EQ(s.foldovers_descent, r.foldovers_descent);
   std::printf("[stat] stiffening alone: fold-overs %d -> %d, E %.6g\n", s.foldovers_descent,
               s.foldovers_final, s.E_final);
+}
+
+// The fold-over removal gives up a constrained solve that is infeasible (InfeasibleLayoutError,
+// SolverError: NodeOptResult::orientation keeps the message) but lets every other error through
+// with its message: invalid orientation options in the given PipelineOptions, which only the
+// constrained solve reads, are the caller's error, not a failed attempt.
+TEST(OrientationNodeOpt, InvalidOrientationOptionsAreNotAFailedAttempt) {
+  const auto in = test::cube_sphere(6);
+  const Layout layout = displaced(in, 4, 1);
+  NodeOptOptions no;
+  no.descent.max_steps = 0;  // the fold-overs of the displaced layout reach the removal
+  PipelineOptions options;
+  options.param.orientation.max_iterations = 0;
+  try {
+    const NodeOptResult r = optimize_nodes(in.mesh, layout, options, no);
+    FAIL() << "taken as a failed attempt: " << r.orientation.message;
+  } catch (const InfeasibleLayoutError& e) {
+    FAIL() << "not an infeasible layout: " << e.what();
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("orientation constraints: invalid options"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 // The command line reports the counts before / after and the method, and --no-orientation
@@ -551,7 +575,7 @@ TEST(OrientationRealData, FandiskInitialLayoutEndsWithoutFoldovers) {
   const QuadImportResult imp =
       import_quads(test::load_poly_mesh(dir + "/fandisk/fandisk_quads.off"), &target, {});
   NodeOptOptions no;
-  no.max_steps = 0;
+  no.descent.max_steps = 0;
   const NodeOptResult r = optimize_nodes(imp.mesh, imp.layout, PipelineOptions{}, no);
   std::printf(
       "[stat] fandisk: fold-overs %d -> %d (%s, %d faces, %d iterations, %.3f s); "

@@ -49,7 +49,7 @@ TEST(Elimination, IncompatibleRowsNameTheirArcs) {
   try {
     eliminate_constraints(sys);
     FAIL() << "incompatible constraints were accepted";
-  } catch (const InvalidInputError& e) {
+  } catch (const InfeasibleLayoutError& e) {  // an input error the node optimizer rejects
     const std::string what = e.what();
     EXPECT_NE(what.find("incompatible constraints (1)"), std::string::npos) << what;
     EXPECT_NE(what.find("arc 7"), std::string::npos) << what;

@@ -201,7 +201,7 @@ RecoveryOutcome run_recovery(const char* name, const test::MeshAndLayout& in,
   out.equivalent = structurally_equivalent(r);
   if (compare) {
     NodeOptOptions plain = no;
-    plain.hop_polish = false;
+    plain.polish.enabled = false;
     const NodeOptResult p = optimize_nodes(in.mesh, perturbed.layout, PipelineOptions{}, plain);
     std::printf("[stat] recovery %s seed %u without the hop polish: %.4f E*, %d steps\n", name,
                 seed, p.E_final / out.E_star, p.steps);

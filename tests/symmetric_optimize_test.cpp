@@ -170,8 +170,25 @@ TEST(SymmetricOptimize, SettingsThatMoveSingleNodesAreRefused) {
   NodeOptOptions no;
   auto wrong = std::make_shared<NodeSymmetry>();
   wrong->node_mirror = {0, 1};
-  no.symmetry = wrong;
+  no.moves.symmetry = wrong;
   EXPECT_THROW(optimize_nodes(in.mesh, in.layout, PipelineOptions{}, no), InvalidInputError);
+}
+
+// The engine's settings reach the node optimizer: its thread count, and the orientation options
+// of the fold-over removal through PipelineOptions (not enabled while nodes move).
+TEST(OptimizeSettings, ThreadsAndOrientationOptionsReachTheOptimizer) {
+  OptimizeSettings s;
+  EXPECT_EQ(node_options(s).run.threads, NodeOptOptions{}.run.threads);
+  s.nodes.threads = 1;
+  s.folds.sectors = SectorFrame::kField;
+  s.folds.untangle = false;
+  EXPECT_EQ(node_options(s).run.threads, 1);
+  const PipelineOptions moving = pipeline_options(s);
+  EXPECT_FALSE(moving.param.orientation.enabled);
+  EXPECT_EQ(moving.param.orientation.sector_frame, SectorFrame::kField);
+  EXPECT_FALSE(moving.param.orientation.untangle);
+  s.nodes.threads = 0;
+  EXPECT_THROW(validate_settings(s), InvalidInputError);
 }
 
 }  // namespace

@@ -50,13 +50,13 @@ struct OptimizeOptions {
   //! Sectors of the orientation constraints: "auto" (field frame, then the solution's where
   //! fold-overs remain), "field" or "solution" (OrientationOptions::sector_frame).
   std::string orientation_sectors = "auto";
-  bool no_untangle = false;       //!< OrientationOptions::untangle off
-  bool no_sliding = false;        //!< nodes on curves stay (NodeOptOptions::slide_on_curves off)
-  bool keep_sharp_edges = false;  //!< NodeOptOptions::sharp_edges_as_curves
-  //! NodeOptOptions::keep_nodes_apart; unset: off, with a retry with it when the fold-over
+  bool no_untangle = false;  //!< OrientationOptions::untangle off
+  bool no_sliding = false;   //!< nodes on curves stay (NodeOptOptions::Moves::slide_on_curves off)
+  bool keep_sharp_edges = false;  //!< NodeOptOptions::Moves::sharp_edges_as_curves
+  //! NodeOptOptions::Moves::keep_nodes_apart; unset: off, with a retry with it when the fold-over
   //! removal leaves fold-overs or falls back to an earlier state.
   std::optional<bool> keep_nodes_apart;
-  bool separate_nodes = false;  //!< NodeOptOptions::separate_crowded_nodes
+  bool separate_nodes = false;  //!< NodeOptOptions::Moves::separate_crowded_nodes
   //! Curl-reducing sizing field (ParamOptions::sizing); unset: the library default.
   std::optional<bool> sizing;
   double sharp_angle_deg = 35.0;

@@ -4,7 +4,7 @@
 // parameterization factor of the 70K bunny: 3.9 M entries, 31 MB). glibc's malloc serves such
 // blocks with fresh mmap()s above its mmap threshold and returns freed heap tops to the kernel
 // above its trim threshold, so every solve page-faults its memory in again, and the kernel
-// zeroes each page. Two solves on two threads of one process (NodeOptOptions::parallel_hops)
+// zeroes each page. Two solves on two threads of one process (NodeOptOptions::Run::threads)
 // also contend for the process's memory map while they fault. Keeping freed memory for reuse
 // removes both. The price is a resident size that does not shrink after a large solve (up to
 // the trim threshold of free memory is kept, per malloc arena). glibc gives threads up to 8

@@ -19,10 +19,19 @@ class InvalidInputError : public QsError {
   using QsError::QsError;
 };
 
-//! A layout whose topology cannot be realized (e.g. inconsistent turning numbers). Exit code 2.
-class TopologyError : public InvalidInputError {
+//! A layout (or a state of it that an optimizer tries) whose constraints contradict each other,
+//! so that no field or parameterization realizes it: the linear constraints of the
+//! parameterization reduce to 0 = c ≠ 0 (e.g. prescribed arc lengths that opposite patch sides
+//! cannot both have). The node optimizer rejects such a trial state. Exit code 2.
+class InfeasibleLayoutError : public InvalidInputError {
  public:
   using InvalidInputError::InvalidInputError;
+};
+
+//! A layout whose topology cannot be realized (e.g. inconsistent turning numbers). Exit code 2.
+class TopologyError : public InfeasibleLayoutError {
+ public:
+  using InfeasibleLayoutError::InfeasibleLayoutError;
 };
 
 //! A numerical solve failed (not positive definite, non-finite values). CLI exit code 3.

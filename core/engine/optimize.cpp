@@ -70,6 +70,7 @@ void validate_settings(const OptimizeSettings& s) {
           s.nodes.alpha, "in (0, 1]");
   require(std::isfinite(s.nodes.time_limit_s) && s.nodes.time_limit_s >= 0, "nodes.time_limit_s",
           s.nodes.time_limit_s, "finite and ≥ 0");
+  require(s.nodes.threads >= 1, "nodes.threads", s.nodes.threads, "≥ 1");
   require(std::isfinite(s.sizes.quad_size) && s.sizes.quad_size >= 0, "sizes.quad_size",
           s.sizes.quad_size, "finite and ≥ 0");
   require(s.sizes.quad_count >= 0, "sizes.quad_count", s.sizes.quad_count, "≥ 0");
@@ -105,30 +106,29 @@ PipelineOptions pipeline_options(const OptimizeSettings& s) {
   if (s.field.wrap_free_holes) o.field.free_loops = FreeLoopTurning::kWrap;
   o.param.anisotropy = s.param.anisotropy;
   o.param.sizing.enabled = s.param.sizing.value_or(false);
-  if (!s.nodes.enabled && s.folds.remove.value_or(false)) {
-    o.param.orientation.enabled = true;
-    o.param.orientation.sector_frame = s.folds.sectors;
-    o.param.orientation.untangle = s.folds.untangle;
-  }
+  // The node optimizer's constrained solves take these too (enabling them itself).
+  o.param.orientation.sector_frame = s.folds.sectors;
+  o.param.orientation.untangle = s.folds.untangle;
+  if (!s.nodes.enabled && s.folds.remove.value_or(false)) o.param.orientation.enabled = true;
   return o;
 }
 
 NodeOptOptions node_options(const OptimizeSettings& s) {
   NodeOptOptions no;
-  no.max_steps = s.nodes.steps;
-  no.alpha = s.nodes.alpha;
-  no.gradient =
+  no.descent.max_steps = s.nodes.steps;
+  no.descent.alpha = s.nodes.alpha;
+  no.descent.gradient =
       s.nodes.method == NodeMethod::kExact ? GradientMethod::Exact : GradientMethod::Estimator;
-  no.orientation_at_end = s.folds.remove.value_or(true);
-  no.orientation.sector_frame = s.folds.sectors;
-  no.orientation.untangle = s.folds.untangle;
-  no.slide_on_curves = s.nodes.slide_on_curves;
-  no.sharp_edges_as_curves = s.nodes.keep_sharp_edges;
-  no.keep_nodes_apart = s.nodes.keep_apart.value_or(false);
-  no.separate_crowded_nodes = s.nodes.separate_crowded;
+  no.moves.slide_on_curves = s.nodes.slide_on_curves;
+  no.moves.sharp_edges_as_curves = s.nodes.keep_sharp_edges;
+  no.moves.keep_nodes_apart = s.nodes.keep_apart.value_or(false);
+  no.moves.separate_crowded_nodes = s.nodes.separate_crowded;
+  // The sector frame and the untangling come with pipeline_options().
+  no.folds.orientation = s.folds.remove.value_or(true);
+  no.run.threads = s.nodes.threads;
   // Integer sizes put nodes exactly on shared iso-lines: fresh trial Pipelines there
-  // (NodeOptOptions::reuse_field).
-  if (s.sizes.integer) no.reuse_field = false;
+  // (NodeOptOptions::Run::reuse_field).
+  if (s.sizes.integer) no.run.reuse_field = false;
   return no;
 }
 
@@ -191,8 +191,8 @@ struct OptimizeRun::Impl {
       return;
     }
     NodeOptOptions no = base_node_options;
-    no.keep_nodes_apart = apart;
-    no.stop = stop();
+    no.moves.keep_nodes_apart = apart;
+    no.run.stop = stop();
     current = std::make_unique<NodeOptimizer>(mesh, layout, po, no, observer);
     apply_pins();
   }
@@ -261,8 +261,9 @@ struct OptimizeRun::Impl {
     PipelineOptions fixed_lengths = options;
     fixed_lengths.param.arc_lengths = result.integer->lengths;
     fixed_lengths.param.face_weights.clear();
-    // The node optimizer's constrained solve is not carried over; fixed nodes keep theirs.
-    if (moving()) fixed_lengths.param.orientation = PipelineOptions{}.param.orientation;
+    // The node optimizer's constrained solve is not carried over (the input's orientation
+    // options, not enabled, are); fixed nodes keep theirs.
+    if (moving()) fixed_lengths.param.orientation = input_options.param.orientation;
     return fixed_lengths;
   }
 
@@ -348,8 +349,8 @@ OptimizeRun::OptimizeRun(TriMesh mesh, Layout layout, const OptimizeSettings& se
       const ClosestPointTree tree(m.input_mesh);
       plane = mirror_plane(m.input_mesh, tree, *settings.nodes.symmetry).plane;
     }
-    m.base_node_options.symmetry = make_node_symmetry(m.input_mesh, m.input_layout, plane);
-    m.result.symmetry = m.base_node_options.symmetry;
+    m.base_node_options.moves.symmetry = make_node_symmetry(m.input_mesh, m.input_layout, plane);
+    m.result.symmetry = m.base_node_options.moves.symmetry;
   }
   if (!m.moving()) {
     m.stage = Impl::Stage::kDone;  // the one solve is made by pipeline() or the caller

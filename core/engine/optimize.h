@@ -25,8 +25,8 @@ namespace qs {
 //! baseline (one vertex hop at a time, core/nodeopt/discrete.h; not steppable: one unit).
 enum class NodeMethod { kEstimator, kExact, kDiscrete };
 
-//! The user-facing settings of one optimize run, in groups. Every other tuning constant of the
-//! node optimizer keeps its NodeOptOptions default. Angles in degrees, times in seconds.
+//! The user-facing settings of one optimize run, in groups. Every other setting of the node
+//! optimizer keeps its NodeOptOptions default. Angles in degrees, times in seconds.
 struct OptimizeSettings {
   struct Field {
     bool align = true;              //!< follow principal curvature directions (--no-align)
@@ -43,9 +43,9 @@ struct OptimizeSettings {
     bool enabled = true;  //!< false: the nodes stay where the layout puts them
     int steps = 25;       //!< descent steps before the first hop sweep (≥ 0)
     NodeMethod method = NodeMethod::kEstimator;
-    double alpha = NodeOptOptions{}.alpha;  //!< initial damping of the steps, in (0, 1]
-    bool slide_on_curves = true;            //!< nodes on features and the boundary slide
-    bool keep_sharp_edges = false;          //!< sharp edges are curves nodes slide along
+    double alpha = NodeOptOptions{}.descent.alpha;  //!< initial damping of the steps, in (0, 1]
+    bool slide_on_curves = true;                    //!< nodes on features and the boundary slide
+    bool keep_sharp_edges = false;                  //!< sharp edges are curves nodes slide along
     //! No node moves next to another node. Unset: off, and the keep-apart retry may turn it on.
     std::optional<bool> keep_apart;
     bool separate_crowded = false;  //!< nodes next to another node move apart first
@@ -58,11 +58,17 @@ struct OptimizeSettings {
     //! The mirror plane itself (e.g. the editor's, already fitted): used instead of computing
     //! the plane of `symmetry`, and turns symmetry on. Unit normal, finite offset.
     std::optional<MirrorPlane> symmetry_plane;
+    //! Threads the node optimizer may use (NodeOptOptions::Run::threads, ≥ 1): 2 or more solve
+    //! hop candidates and a fold-over removal fallback beside the main thread, 3 or more also a
+    //! descent trial beside its retry. The same results for every value.
+    int threads = NodeOptOptions{}.run.threads;
   } nodes;
   struct Folds {
     //! Remove fold-overs with orientation constraints: with moving nodes at the end of each
     //! node optimization, with fixed nodes in the one solve. Unset: on with moving nodes, off
-    //! with fixed ones.
+    //! with fixed ones. `sectors` and `untangle` go into PipelineOptions::param.orientation in
+    //! either case (enabled only for fixed nodes), whose options the node optimizer's
+    //! constrained solves take.
     std::optional<bool> remove;
     SectorFrame sectors = SectorFrame::kFieldThenSolution;
     bool untangle = true;  //!< untangle where the orientation constraints leave fold-overs
@@ -82,7 +88,7 @@ void validate_settings(const OptimizeSettings& settings);
 bool symmetric(const OptimizeSettings& settings);
 
 //! The solver options that \p settings mean (the field and parameterization options of the
-//! first attempt, before any retry).
+//! first attempt, before any retry; the orientation options of the fold-over removal).
 PipelineOptions pipeline_options(const OptimizeSettings& settings);
 //! The node optimizer options that \p settings mean (keep_nodes_apart as given or off).
 NodeOptOptions node_options(const OptimizeSettings& settings);

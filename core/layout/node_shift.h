@@ -75,8 +75,8 @@ class NodeShifter {
 };
 
 //! Moves nodes apart that sit closer than options.min_distance edges to another node (node
-//! optimization with nodes kept apart, NodeOptOptions::separate_crowded_nodes: a displaced layout
-//! can put two nodes on one triangle, where the orientation constraints cannot unfold the
+//! optimization with nodes kept apart, NodeOptOptions::Moves::separate_crowded_nodes: a displaced
+//! layout can put two nodes on one triangle, where the orientation constraints cannot unfold the
 //! patches between them). Each crowded node that \p movable allows (one flag per layout node;
 //! empty: all) and that may move (NodeShifter::may_move: not pinned, no pinned or loop arc)
 //! goes to the nearest vertex (fewest edge rings, then farthest from the nodes crowding it)

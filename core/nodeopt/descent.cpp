@@ -10,7 +10,6 @@
 #include <future>
 #include <memory>
 #include <optional>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -26,6 +25,11 @@ namespace qs {
 
 using nodeopt_detail::emit_step;
 using nodeopt_detail::Evaluation;
+using nodeopt_detail::kEstimatorScale;
+using nodeopt_detail::kExactScale;
+using nodeopt_detail::kMaxHalvings;
+using nodeopt_detail::kMinStepRelative;
+using nodeopt_detail::kSwitchTabuOverlap;
 using nodeopt_detail::solve_and_measure;
 
 namespace {
@@ -51,15 +55,14 @@ bool NodeOptimizer::Impl::step() {
   }
   if (!started) {
     started = true;
-    if (no.hop_polish && no.hop_cones_first && !movable.empty()) {
+    if (no.polish.enabled && !movable.empty()) {
       const int rounds = result.hop_rounds;
       hop_round(true);
       if (result.hop_rounds > rounds) return true;
     }
   }
-  const bool stalled = no.stall_gain > 0 && stalled_steps >= no.stall_steps;
-  if (movable.empty() || result.steps >= step_budget || phase_halvings > no.max_halvings ||
-      stalled) {
+  const bool stalled = no.tuning.stall_gain > 0 && stalled_steps >= no.tuning.stall_steps;
+  if (movable.empty() || result.steps >= step_budget || phase_halvings > kMaxHalvings || stalled) {
     if (!movable.empty() && polish()) return true;
     descent_over = true;
     return false;
@@ -81,14 +84,15 @@ bool NodeOptimizer::Impl::step() {
     // Gradients at the current solution (the future waits in its destructor if they throw).
     std::vector<int> vertices;
     for (int n : movable) vertices.push_back(state.layout.nodes[n].vertex);
-    if (no.gradient == GradientMethod::Exact) {
-      grad = exact_node_gradients(state.mesh, state.layout, options, vertices, no.exact, observer);
-      scale = no.exact_scale;
+    if (no.descent.gradient == GradientMethod::Exact) {
+      grad = exact_node_gradients(state.mesh, state.layout, options, vertices,
+                                  ExactGradientOptions{}, observer);
+      scale = kExactScale;
     } else {
       const Pipeline& p = *current.pipeline;
       grad = estimate_node_gradients(p.mesh(), p.geometry(), p.field()->theta,
                                      *p.parameterization(), options.param, vertices);
-      scale = no.estimator_scale;
+      scale = kEstimatorScale;
     }
     cell = cells.valid() ? cells.get() : node_voronoi_cells(original, all_vertices);
     state_changed = false;
@@ -101,9 +105,9 @@ bool NodeOptimizer::Impl::step() {
   auto trace_step = [&](size_t i, const SurfacePoint& anchor) -> std::optional<GeodesicTrace> {
     const int n = movable[i];
     const double len = alpha * damping[i] * scale * grad[i].norm();
-    if (len < no.min_step_relative * mean_edge) return std::nullopt;
+    if (len < kMinStepRelative * mean_edge) return std::nullopt;
+    // The Voronoi safeguard: the trace stays in the node's Dijkstra-Voronoi cell.
     auto blocked = [&](int f) {
-      if (!no.voronoi_safeguard) return false;
       for (auto vh : original.fv_range(original.face_handle(f)))
         if (cell[vh.idx()] == n || cell[vh.idx()] < 0) return false;
       return true;
@@ -149,8 +153,8 @@ bool NodeOptimizer::Impl::step() {
             !occupied_by_layout(trial.layout, n, obstacles, near) &&
             relocation_keeps_orientation(trial.mesh, original, v, near,
                                          original.point(original.vertex_handle(near)),
-                                         no.relocation) &&
-            move_node_and_reroute(trial.mesh, trial.layout, n, near, no.relocation, &reroute,
+                                         relocation) &&
+            move_node_and_reroute(trial.mesh, trial.layout, n, near, relocation, &reroute,
                                   &obstacles)) {
           trial.mesh.set_point(trial.mesh.vertex_handle(v),
                                original.point(original.vertex_handle(v)));
@@ -168,10 +172,10 @@ bool NodeOptimizer::Impl::step() {
                (u != v && next_to_other_node(v, u));
       };
       const int w = choose_relocation_vertex(trial.mesh, original, tr.end, tr.end_position, v,
-                                             forbidden, no.relocation);
+                                             forbidden, relocation);
       if (w < 0) continue;
       if (w != v) {
-        if (!move_node_and_reroute(trial.mesh, trial.layout, n, w, no.relocation, &reroute,
+        if (!move_node_and_reroute(trial.mesh, trial.layout, n, w, relocation, &reroute,
                                    &obstacles))
           continue;
         trial.mesh.set_point(trial.mesh.vertex_handle(v),
@@ -186,7 +190,7 @@ bool NodeOptimizer::Impl::step() {
     }
     return moved;
   };
-  // ---- symmetric optimization (NodeOptOptions::symmetry; symmetric_step.h) ----
+  // ---- symmetric optimization (NodeOptOptions::Moves::symmetry; symmetric_step.h) ----
   // The trial of the step's targets made symmetric, built again without the pairs it could not
   // realize as mirror images.
   auto build_trial = [&](const std::vector<char>& no_switch, State& trial,
@@ -216,10 +220,10 @@ bool NodeOptimizer::Impl::step() {
         next = evaluate_switched(trial.mesh, trial.layout);
       }
       return true;
-    } catch (const Cancelled&) {
-      throw;
-    } catch (const QsError&) {
+    } catch (const InfeasibleLayoutError&) {
       return false;  // e.g. a layout the field cannot realize: treat like an increase
+    } catch (const SolverError&) {
+      return false;
     }
   };
   State trial;
@@ -244,26 +248,25 @@ bool NodeOptimizer::Impl::step() {
   }
   Evaluation next;
   // Mostly the switches of a trial rejected at this α: rejected again without a solve, the
-  // retry without switches follows (switch_tabu).
+  // retry without switches follows (tuning.switch_tabu).
   int n_switched = 0, n_repeated = 0;
   for (size_t i = 0; i < movable.size(); ++i) {
     n_switched += switched[i];
     n_repeated += switched[i] && first_target[i] == rejected_target[i];
   }
   const bool repeated =
-      no.switch_tabu && n_switched > 0 && n_repeated >= no.switch_tabu_overlap * n_switched;
+      no.tuning.switch_tabu && n_switched > 0 && n_repeated >= kSwitchTabuOverlap * n_switched;
   counters.tabu_steps += repeated;
   // The retry without switches (below) does not depend on the re-layout's result: with
-  // parallel_retry it is solved on this thread while the re-layout is solved on another.
+  // run.threads ≥ 3 it is solved on this thread while the re-layout is solved on another.
   State retry;
   std::vector<char> retry_switched;
   bool retry_built = false;
   Evaluation second;
   bool second_ok = false;
   bool ok = false;
-  const bool retry_possible = no.retry_without_switches && n_switched > 0 && !repeated;
-  if (retry_possible && no.parallel_retry && no.reuse_field && current.pipeline->field() &&
-      std::thread::hardware_concurrency() >= 2) {
+  const bool retry_possible = n_switched > 0 && !repeated;
+  if (retry_possible && parallel(3) && no.run.reuse_field && current.pipeline->field()) {
     retry_built = true;
     const bool retry_moves = build_trial(switched, retry, retry_switched) > 0;
     const bool retry_reuses =
@@ -276,7 +279,9 @@ bool NodeOptimizer::Impl::step() {
       try {
         p = std::make_shared<Pipeline>(trial.mesh, trial.layout, *current.pipeline);
         p->unshare_solvers();
-      } catch (const QsError&) {
+      } catch (const InfeasibleLayoutError&) {
+        p.reset();
+      } catch (const SolverError&) {
         p.reset();
       }
       if (p) {
@@ -292,8 +297,10 @@ bool NodeOptimizer::Impl::step() {
         try {
           next = first.get();
           ok = true;
-        } catch (const QsError&) {
+        } catch (const InfeasibleLayoutError&) {
           ok = false;  // e.g. a layout the field cannot realize: treat like an increase
+        } catch (const SolverError&) {
+          ok = false;
         }
       } else {
         ok = false;
@@ -312,7 +319,7 @@ bool NodeOptimizer::Impl::step() {
     rejected_target = first_ok ? std::vector<int>(movable.size(), -1) : first_target;
   // A node that changed its vertex can raise E discontinuously: retry once with those nodes
   // kept on their vertices before halving α.
-  if (no.retry_without_switches && !(ok && next.E <= current.E) && n_switched > 0) {
+  if (!(ok && next.E <= current.E) && n_switched > 0) {
     if (!retry_built && build_trial(switched, retry, retry_switched) > 0)
       second_ok = try_evaluate(retry, retry_switched, second);
     if (second_ok && second.E <= current.E) {
@@ -323,7 +330,7 @@ bool NodeOptimizer::Impl::step() {
   }
   // The sliding nodes whose switches raised E take half steps from now on (until one of their
   // switches is accepted or a hop sweep starts a new phase).
-  if (no.damp_rejected_slides && !repeated && n_switched > 0 && !first_ok)
+  if (!repeated && n_switched > 0 && !first_ok)
     for (size_t i = 0; i < movable.size(); ++i)
       if (first_target[i] >= 0 && on_curve(first_target[i])) damping[i] *= 0.5;
   r.accepted = ok && next.E <= current.E;
@@ -333,7 +340,7 @@ bool NodeOptimizer::Impl::step() {
     for (size_t i = 0; i < movable.size(); ++i)
       if (trial.layout.nodes[movable[i]].vertex != state.layout.nodes[movable[i]].vertex)
         damping[i] = 1;
-    const bool small_gain = current.E - next.E < no.stall_gain * current.E;
+    const bool small_gain = current.E - next.E < no.tuning.stall_gain * current.E;
     stalled_steps = small_gain ? stalled_steps + 1 : 0;
     accepted_alpha = alpha;
     note_fold_count(state, next.foldovers);

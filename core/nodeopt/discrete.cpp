@@ -6,6 +6,7 @@
 #include <future>
 #include <thread>
 
+#include "core/base/errors.h"
 #include "core/base/timing.h"
 #include "core/nodeopt/gradient.h"
 
@@ -239,9 +240,9 @@ NodeOptResult relocate_nodes_discrete(const TriMesh& mesh, const Layout& layout,
       E = unweighted_energy(p.mesh(), p.geometry(), p.field()->theta, r, options.param);
       folds = r.foldovers;
       return true;
-    } catch (const Cancelled&) {
-      throw;
-    } catch (const QsError&) {
+    } catch (const InfeasibleLayoutError&) {  // a candidate that cannot be realized
+      return false;
+    } catch (const SolverError&) {
       return false;
     }
   };

@@ -1,7 +1,7 @@
 // Discrete singularity relocation (BZK09, paper §6.3): nodes hop to neighbouring vertices
 // (re-routing their arcs) when that lowers the residual E. The baseline runs it alone (slow on
 // purpose: every candidate is a full field + parameterization solve); the continuous optimizer
-// uses one sweep as its polish when the descent has converged (NodeOptOptions::hop_polish).
+// uses one sweep as its polish when the descent has converged (NodeOptOptions::polish).
 #pragma once
 
 #include <functional>
@@ -35,8 +35,9 @@ struct DiscreteOptions {
 //! Runs the discrete baseline on the original mesh positions (no vertex relocation). Nodes move
 //! one at a time (Gauss–Seidel): a node's best neighbour is accepted at once when it lowers E.
 //! Stops when a sweep improves nothing, at max_steps / max_evaluations, or when
-//! DiscreteOptions::stop says so. One StepReport per sweep. \throw InvalidInputError,
-//! TopologyError, SolverError, Cancelled.
+//! DiscreteOptions::stop says so. One StepReport per sweep. A candidate whose solve throws
+//! InfeasibleLayoutError or SolverError is not taken; other errors propagate.
+//! \throw InvalidInputError, InfeasibleLayoutError and SolverError (the initial solve), Cancelled.
 NodeOptResult relocate_nodes_discrete(const TriMesh& mesh, const Layout& layout,
                                       const PipelineOptions& options,
                                       const DiscreteOptions& discrete = {},

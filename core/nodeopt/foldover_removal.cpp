@@ -12,7 +12,6 @@
 #include <future>
 #include <memory>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -78,7 +77,8 @@ NodeOptResult NodeOptimizer::Impl::finish(NodeOptStats* stats) {
   auto stiffen_into = [&](const State& st, const std::shared_ptr<Pipeline>& descent,
                           NodeOptResult& out) {
     const auto t_st = std::chrono::steady_clock::now();
-    const StiffeningResult sr = stiffen(st.mesh, st.layout, options, no.stiffening, observer);
+    const StiffeningResult sr =
+        stiffen(st.mesh, st.layout, options, no.tuning.stiffening, observer);
     out.stiffening_iterations = sr.iterations;
     if (sr.foldovers_after < out.foldovers_final) {
       out.orientation_constraints = false;
@@ -101,15 +101,18 @@ NodeOptResult NodeOptimizer::Impl::finish(NodeOptStats* stats) {
   // waits until every state's orientation solve was tried: it is the costlier fallback and
   // rarely removes what the constraints could not (the 70K bunny after the polish: 147 → 142
   // fold-overs in 5.6 s), while the orientation solve at an earlier state often succeeds.
+  // The message of a failed untangling, appended to the fold-over removal's.
+  auto untangling_message = [&](const std::exception& e) {
+    return std::string(result.orientation.message.empty() ? "" : "; ") + "untangling: " + e.what();
+  };
   const bool try_fewest = fewest_folds && fewest_folds_count < current.foldovers;
-  const bool has_earlier = no.orientation_at_end && (pre_polish || try_fewest);
+  const bool has_earlier = no.folds.orientation && (pre_polish || try_fewest);
   // One orientation-constrained solve of \p st (\p untangle: OrientationOptions::untangle;
   // \p fallback: as remove_foldovers'), polled by \p obs; its options, without the observer,
   // into \p used.
   auto oriented_solve = [&](const State& st, bool untangle, bool fallback, Observer* obs,
                             OrientationOptions& used) {
-    PipelineOptions oriented = options;
-    oriented.param.orientation = no.orientation;
+    PipelineOptions oriented = options;  // the caller's orientation options, enabled
     oriented.param.orientation.enabled = true;
     oriented.param.orientation.observer = obs;  // polled inside the solve (seconds long)
     oriented.param.orientation.untangle = untangle;
@@ -151,9 +154,9 @@ NodeOptResult NodeOptimizer::Impl::finish(NodeOptStats* stats) {
 
     // Fold-over removal: strict orientation constraints in the last solve (docs/design.md,
     // "Orientation constraints"), stiffening (§7.1) only as the fallback when fold-overs remain.
-    const bool at_this_state =
-        no.orientation_at_moved_states || (initial_state && same_state(*initial_state, st_in));
-    if (no.orientation_at_end && ev.foldovers > 0 && at_this_state) {
+    const bool at_this_state = no.tuning.orientation_at_moved_states ||
+                               (initial_state && same_state(*initial_state, st_in));
+    if (no.folds.orientation && ev.foldovers > 0 && at_this_state) {
       const auto t_or = std::chrono::steady_clock::now();
       check_cancel(obs);
       try {
@@ -170,18 +173,18 @@ NodeOptResult NodeOptimizer::Impl::finish(NodeOptStats* stats) {
           out.foldovers_final = par.foldovers;
           out.pipeline = std::move(p);
         }
-      } catch (const Cancelled&) {
-        throw;
-      } catch (const QsError& e) {
+      } catch (const InfeasibleLayoutError& e) {
+        out.orientation.message = e.what();
+      } catch (const SolverError& e) {
         out.orientation.message = e.what();
       }
       emit_orientation(st_in, out, out.orientation_constraints, t_or, out.reports, obs);
     }
-    if (stiffen && no.stiffen_at_end && out.foldovers_final > 0)
+    if (stiffen && no.folds.stiffen && out.foldovers_final > 0)
       stiffen_into(st_in, ev.pipeline, out);
   };
   // The fold-over removal at the state before the polish, solved speculatively
-  // (parallel_fallback). Declared after the lambda and the states it reads: its destructor
+  // (run.threads ≥ 2). Declared after the lambda and the states it reads: its destructor
   // waits for it before they go away. `stop` ends it at its next poll once it is not needed.
   struct Speculative {
     Evaluation evaluation;
@@ -197,11 +200,10 @@ NodeOptResult NodeOptimizer::Impl::finish(NodeOptStats* stats) {
     StopFlag& flag;
     ~StopOnExit() { flag.stop = true; }
   } stop_on_exit{speculative_stop};
-  // parallel_fallback: the state before the polish is solved and oriented on a second thread
+  // run.threads ≥ 2: the state before the polish is solved and oriented on a second thread
   // while this one orients the final state; its result (and its reports) are used exactly when
   // the sequential order would have tried it.
-  if (no.orientation_at_end && pre_polish && current.foldovers > 0 && no.parallel_fallback &&
-      std::thread::hardware_concurrency() >= 2) {
+  if (no.folds.orientation && pre_polish && current.foldovers > 0 && parallel(2)) {
     const State* earlier = pre_polish.get();
     const bool later = try_fewest;
     speculative = std::async(std::launch::async, [&, earlier, later]() {
@@ -260,8 +262,8 @@ NodeOptResult NodeOptimizer::Impl::finish(NodeOptStats* stats) {
     }
     earlier.reset();
   };
-  if (!no.orientation_at_end && !no.stiffen_at_end) pre_polish.reset(), fewest_folds.reset();
-  // The initial state last (NodeOptOptions::initial_fallback), unless it is one of the states
+  if (!no.folds.orientation && !no.folds.stiffen) pre_polish.reset(), fewest_folds.reset();
+  // The initial state last (NodeOptTuning::initial_fallback), unless it is one of the states
   // tried before; with orientation constraints only (no stiffening of it: the state tried
   // before keeps its stiffening). Which states are the initial one, before try_earlier
   // moves them.
@@ -283,7 +285,7 @@ NodeOptResult NodeOptimizer::Impl::finish(NodeOptStats* stats) {
       initial_taken ||
       (result.fewest_foldovers_reverted ? fewest_is_initial
                                         : result.polish_reverted && pre_polish_is_initial);
-  if (has_earlier && no.stiffen_at_end && result.foldovers_final > 0)
+  if (has_earlier && no.folds.stiffen && result.foldovers_final > 0)
     stiffen_into(state, result.descent_pipeline, result);
   // The last resort: the untangling (untangle.h) at the state returned, when the tri-sector
   // constraints left fold-overs at every state tried and stiffening did too. Not inside those
@@ -291,7 +293,7 @@ NodeOptResult NodeOptimizer::Impl::finish(NodeOptStats* stats) {
   // and the constraints' failure at a state often marks wrong cones that an earlier state does
   // not have (the rocker-arm cage layout: untangled at its final state, 0 fold-overs and 7 bad
   // cones; its fewest-fold-over state embeds structurally equivalent).
-  if (no.orientation_at_end && no.orientation.untangle && result.foldovers_final > 0) {
+  if (no.folds.orientation && options.param.orientation.untangle && result.foldovers_final > 0) {
     const auto t_un = std::chrono::steady_clock::now();
     check_cancel(observer);
     try {
@@ -310,11 +312,10 @@ NodeOptResult NodeOptimizer::Impl::finish(NodeOptStats* stats) {
         result.pipeline = std::move(p);
         result.untangled = true;
       }
-    } catch (const Cancelled&) {
-      throw;
-    } catch (const QsError& e) {
-      result.orientation.message +=
-          std::string(result.orientation.message.empty() ? "" : "; ") + "untangling: " + e.what();
+    } catch (const InfeasibleLayoutError& e) {
+      result.orientation.message += untangling_message(e);
+    } catch (const SolverError& e) {
+      result.orientation.message += untangling_message(e);
     }
     emit_orientation(state, result, result.untangled, t_un, result.reports, observer);
   }

@@ -7,7 +7,6 @@
 #include <chrono>
 #include <memory>
 #include <mutex>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -23,13 +22,16 @@ namespace qs {
 
 using nodeopt_detail::emit_step;
 using nodeopt_detail::Evaluation;
+using nodeopt_detail::kHopConeMaxEvaluations;
+using nodeopt_detail::kHopConeTolerance;
 using nodeopt_detail::pipeline_matches;
 using nodeopt_detail::solve_and_measure;
 
 namespace {
 
 // Runs \p solve (which returns an Evaluation) and gives its E and fold-overs; false when it
-// throws a QsError (a layout the field cannot realize, …). Cancelled passes through.
+// throws InfeasibleLayoutError (a layout the field cannot realize, …) or SolverError. Other
+// errors (Cancelled among them) pass through.
 template <typename Solve>
 bool measured(Solve&& solve, double& E, int& foldovers) {
   try {
@@ -37,9 +39,9 @@ bool measured(Solve&& solve, double& E, int& foldovers) {
     E = ev.E;
     foldovers = ev.foldovers;
     return true;
-  } catch (const Cancelled&) {
-    throw;
-  } catch (const QsError&) {
+  } catch (const InfeasibleLayoutError&) {
+    return false;
+  } catch (const SolverError&) {
     return false;
   }
 }
@@ -54,7 +56,6 @@ bool NodeOptimizer::Impl::hop_round(bool cones_only) {
   std::mutex best_mutex;
   Evaluation best;
   auto keep_if_best = [&](Evaluation ev) {
-    if (!no.reuse_hop_solve) return;
     std::lock_guard<std::mutex> lock(best_mutex);
     if (!best.pipeline || ev.E < best.E) best = std::move(ev);
   };
@@ -67,14 +68,16 @@ bool NodeOptimizer::Impl::hop_round(bool cones_only) {
         },
         E, folds);
   };
-  // Two at a time (parallel_hops): each job's Pipeline is built here and owns its
+  // Two at a time (run.threads ≥ 2): each job's Pipeline is built here and owns its
   // factorizations before any thread solves it.
   const HopJobMaker make_job = [&](const TriMesh& m, const Layout& l) -> HopJob {
     ++counters.parallel_hop_jobs;
     std::shared_ptr<Pipeline> p;
     try {
       p = switched_pipeline(m, l, true);
-    } catch (const QsError&) {
+    } catch (const InfeasibleLayoutError&) {
+      return [](double&, int&) { return false; };
+    } catch (const SolverError&) {
       return [](double&, int&) { return false; };
     }
     const PipelineOptions* opts = &options;
@@ -90,8 +93,7 @@ bool NodeOptimizer::Impl::hop_round(bool cones_only) {
           E, folds);
     };
   };
-  const HopJobMaker* jobs =
-      no.parallel_hops && std::thread::hardware_concurrency() >= 2 ? &make_job : nullptr;
+  const HopJobMaker* jobs = parallel(2) ? &make_job : nullptr;
   State hopped = state;
   HopSweepResult h;
   h.E = current.E;
@@ -100,9 +102,9 @@ bool NodeOptimizer::Impl::hop_round(bool cones_only) {
   // draws on the neighbour hops' budget).
   auto run_sweep = [&](const std::vector<int>& nodes, const std::vector<Vec3>& directions,
                        HopSweepOptions sweep, bool counts_evaluations) {
-    sweep.relocation = no.relocation;
-    sweep.keep_nodes_apart = no.keep_nodes_apart;
-    sweep.stop = no.stop;
+    sweep.relocation = relocation;
+    sweep.keep_nodes_apart = no.moves.keep_nodes_apart;
+    sweep.stop = no.run.stop;
     if (nodes.empty() || sweep.max_evaluations <= 0) return;
     const HopSweepResult s = hop_sweep(original, hopped.mesh, hopped.layout, nodes, directions, h.E,
                                        h.foldovers, sweep, evaluate, observer, &reroute, jobs);
@@ -128,21 +130,21 @@ bool NodeOptimizer::Impl::hop_round(bool cones_only) {
       nodes.push_back(n);
       directions.push_back(hopped.mesh.point(vh) - original.point(vh));
     }
-    sweep.max_evaluations = no.hop_max_evaluations - h.evaluations;
+    sweep.max_evaluations = no.tuning.hop_max_evaluations - h.evaluations;
     run_sweep(nodes, directions, sweep, true);
   };
   // Sharp cone vertices (discrete.h cone_candidates; none on smooth meshes).
   ConeCandidates cones;
   auto find_cones = [&]() {
-    if (!no.hop_cones) return;
+    if (!no.tuning.hop_cones) return;
     if (deficits.empty()) deficits = vertex_angle_deficits(original_geometry);
     std::vector<int> cone_nodes;  // all but the nodes on the boundary
     for (int n : movable)
       if (!original.is_boundary(original.vertex_handle(hopped.layout.nodes[n].vertex)))
         cone_nodes.push_back(n);
     cones = cone_candidates(original, hopped.mesh, hopped.layout, cone_nodes,
-                            current.pipeline->topology().valence, deficits, no.hop_cone_tolerance,
-                            no.hop_cone_rings, no.hop_cone_targets);
+                            current.pipeline->topology().valence, deficits, kHopConeTolerance,
+                            no.tuning.hop_cone_rings, no.tuning.hop_cone_targets);
   };
   find_cones();
   if (cones_only && cones.hop_nodes.empty() && cones.snap_nodes.empty()) return false;
@@ -150,7 +152,7 @@ bool NodeOptimizer::Impl::hop_round(bool cones_only) {
   // All at once first, one solve (single moves miss collective optima: one node on its cone
   // or vertex while its neighbours are not can raise E): every relocation undone and every
   // node off its cone onto its nearest fitting vertex.
-  if (no.hop_collective && !stop_requested()) {
+  if (no.tuning.hop_collective && !stop_requested()) {
     check_cancel(observer);
     State all = hopped;
     int moved = 0;
@@ -161,10 +163,10 @@ bool NodeOptimizer::Impl::hop_round(bool cones_only) {
     for (size_t i = 0; i < cones.hop_nodes.size(); ++i) {
       const int n = cones.hop_nodes[i];
       const std::vector<char> forbidden =
-          forbidden_relocation_vertices(original, all.layout, n, no.keep_nodes_apart);
+          forbidden_relocation_vertices(original, all.layout, n, no.moves.keep_nodes_apart);
       for (int w : cones.hop_targets[i])
         if (!forbidden[w] &&
-            move_node_and_reroute(all.mesh, all.layout, n, w, no.relocation, &reroute)) {
+            move_node_and_reroute(all.mesh, all.layout, n, w, relocation, &reroute)) {
           ++moved;
           break;
         }
@@ -183,8 +185,8 @@ bool NodeOptimizer::Impl::hop_round(bool cones_only) {
   // Then one node at a time (own budget): relocations off a fitting cone undone, and hops
   // onto a fitting cone nearby.
   auto cone_sweep = [&](const std::vector<int>& nodes, HopSweepOptions sweep) {
-    sweep.max_evaluations = no.hop_cone_max_evaluations;
-    sweep.max_failures = no.hop_cone_max_failures;
+    sweep.max_evaluations = kHopConeMaxEvaluations;
+    sweep.max_failures = no.tuning.hop_cone_max_failures;
     run_sweep(nodes, {}, sweep, false);
   };
   {
@@ -198,10 +200,10 @@ bool NodeOptimizer::Impl::hop_round(bool cones_only) {
   }
   if (!cones_only) {  // relocated nodes, farthest off their vertex first, try neighbours
     HopSweepOptions sweep;
-    sweep.max_candidates = no.hop_candidates;
-    sweep.min_direction_cos = no.hop_min_cos;
-    sweep.max_failures = no.hop_max_failures;
-    sweep_nodes(no.hop_min_offset, sweep);
+    sweep.max_candidates = no.tuning.hop_candidates;
+    sweep.min_direction_cos = no.tuning.hop_min_cos;
+    sweep.max_failures = no.tuning.hop_max_failures;
+    sweep_nodes(no.tuning.hop_min_offset, sweep);
     // Sliding nodes relocated along their curve hop to the curve neighbour they lean to.
     std::vector<std::pair<double, int>> leaning;  // (−t, node)
     for (int n : movable) {
@@ -214,13 +216,13 @@ bool NodeOptimizer::Impl::hop_round(bool cones_only) {
     std::sort(leaning.begin(), leaning.end());
     HopSweepOptions along;
     along.curves = &curves;
-    along.max_failures = no.hop_max_failures;
+    along.max_failures = no.tuning.hop_max_failures;
     std::vector<int> nodes;
     for (const auto& [t, n] : leaning) {
       nodes.push_back(n);
       along.targets.push_back({hopped.curve[n].toward});
     }
-    along.max_evaluations = no.hop_max_evaluations - h.evaluations;
+    along.max_evaluations = no.tuning.hop_max_evaluations - h.evaluations;
     run_sweep(nodes, {}, along, true);
   }
   bool kept = false;
@@ -237,7 +239,7 @@ bool NodeOptimizer::Impl::hop_round(bool cones_only) {
     // The kept candidate's own solve when it is the best one solved (always, unless a
     // discarded parallel solve was lower); otherwise the state is solved again.
     Evaluation next;
-    if (no.reuse_hop_solve && best.pipeline && best.E == h.E &&
+    if (best.pipeline && best.E == h.E &&
         pipeline_matches(*best.pipeline, hopped.mesh, hopped.layout)) {
       next = std::move(best);
       ++counters.reused_hop_solves;
@@ -270,18 +272,18 @@ bool NodeOptimizer::Impl::hop_round(bool cones_only) {
 }
 
 bool NodeOptimizer::Impl::polish() {
-  if (!no.hop_polish || polish_rounds >= no.max_hop_rounds) return false;
+  if (!no.polish.enabled || polish_rounds >= no.tuning.max_hop_rounds) return false;
   ++polish_rounds;
   if (!hop_round(false)) return false;
-  alpha = no.hop_alpha_growth > 0 && accepted_alpha > 0
-              ? std::min(no.alpha, no.hop_alpha_growth * accepted_alpha)
-              : no.alpha;
+  const double growth = no.tuning.hop_alpha_growth;
+  alpha = growth > 0 && accepted_alpha > 0 ? std::min(no.descent.alpha, growth * accepted_alpha)
+                                           : no.descent.alpha;
   accepted_alpha = 0;
   phase_halvings = 0;
   stalled_steps = 0;
   std::fill(rejected_target.begin(), rejected_target.end(), -1);
   std::fill(damping.begin(), damping.end(), 1.0);
-  step_budget = std::max(step_budget, result.steps + no.hop_descent_steps);
+  step_budget = std::max(step_budget, result.steps + no.tuning.hop_descent_steps);
   return true;
 }
 

@@ -21,11 +21,11 @@ namespace nodeopt_detail {
 
 CurveNetwork curve_network(const TriMesh& mesh, const GeometryCache& g, const Layout& layout,
                            const PipelineOptions& options, const NodeOptOptions& no) {
-  if (!no.slide_on_curves) return {};
-  if (!no.sharp_edges_as_curves) return make_curve_network(mesh, layout, no.curve_corner_deg);
+  if (!no.moves.slide_on_curves) return {};
+  if (!no.moves.sharp_edges_as_curves) return make_curve_network(mesh, layout, kCurveCornerDeg);
   const std::vector<char> sharp =
       sharp_edges(mesh, g, options.field.constraints.sharp_angle_deg, nullptr);
-  return make_curve_network(mesh, layout, no.curve_corner_deg, &sharp);
+  return make_curve_network(mesh, layout, kCurveCornerDeg, &sharp);
 }
 
 }  // namespace nodeopt_detail
@@ -102,7 +102,7 @@ bool NodeOptimizer::Impl::slide_on_curve(State& trial, size_t i, int n, bool no_
   }
   if (seq.empty()) return false;
   double remaining = alpha * damping[i] * scale * best;
-  if (remaining < no.min_step_relative * mean_edge) return false;
+  if (remaining < nodeopt_detail::kMinStepRelative * mean_edge) return false;
   // Vertices the walk may not pass or take: other nodes and other arcs; it stops on a free
   // curve end, junction or corner (the node then sits on that vertex, which keeps its place).
   auto occupied = [&](int c) {
@@ -157,7 +157,7 @@ bool NodeOptimizer::Impl::slide_on_curve(State& trial, size_t i, int n, bool no_
     const Vec3 at = f <= 0   ? point(seq[k])
                     : f >= 1 ? point(seq[k + 1])
                              : point(seq[k]) + f * (point(seq[k + 1]) - point(seq[k]));
-    if (!relocation_keeps_orientation(trial.mesh, original, w == v ? -1 : v, w, at, no.relocation))
+    if (!relocation_keeps_orientation(trial.mesh, original, w == v ? -1 : v, w, at, relocation))
       continue;
     if (w != v && next_to_other_node(v, w)) continue;
     if (w != v) {
@@ -168,8 +168,8 @@ bool NodeOptimizer::Impl::slide_on_curve(State& trial, size_t i, int n, bool no_
       else
         for (size_t j = iv + 1; j-- > iw;) path.push_back(seq[j]);
       const CurveWalk walk = make_curve_walk(curves, std::move(path));
-      if (!move_node_and_reroute(trial.mesh, trial.layout, n, w, no.relocation, &reroute,
-                                 &obstacles, &walk))
+      if (!move_node_and_reroute(trial.mesh, trial.layout, n, w, relocation, &reroute, &obstacles,
+                                 &walk))
         continue;
       trial.mesh.set_point(trial.mesh.vertex_handle(v), point(v));
       switched[i] = 1;
@@ -187,7 +187,7 @@ bool NodeOptimizer::Impl::slide_on_curve(State& trial, size_t i, int n, bool no_
 
 void NodeOptimizer::Impl::count_nodes_near(const Layout& layout) {
   near_count.clear();
-  if (!no.keep_nodes_apart) return;
+  if (!no.moves.keep_nodes_apart) return;
   near_count.assign(original.n_vertices(), 0);
   for (const auto& node : layout.nodes) add_near_count(node.vertex, 1);
 }

@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <stdexcept>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -100,13 +101,14 @@ NodeOptimizer::Impl::Impl(const TriMesh& mesh, const Layout& layout,
       mean_edge(original_geometry.mean_edge_length),
       curves(curve_network(mesh, original_geometry, layout, options_in, no_in)),
       reroute(make_reroute_context(mesh, layout)),
-      symmetric(no_in.symmetry
-                    ? std::make_unique<const SymmetricStepper>(original, layout, no_in.symmetry)
-                    : nullptr),
-      alpha(no_in.alpha),
-      step_budget(no_in.max_steps) {
+      symmetric(no_in.moves.symmetry ? std::make_unique<const SymmetricStepper>(
+                                           original, layout, no_in.moves.symmetry)
+                                     : nullptr),
+      alpha(no_in.descent.alpha),
+      step_budget(no_in.descent.max_steps) {
   for (const auto& n : layout.nodes) state.anchor.push_back(vertex_surface_point(mesh, n.vertex));
-  if (no.orientation_at_end && no.initial_fallback) initial_state = std::make_unique<State>(state);
+  if (no.folds.orientation && no.tuning.initial_fallback)
+    initial_state = std::make_unique<State>(state);
   compute_movable();
   for (int n : movable) result.sliding_nodes += on_curve(state.layout.nodes[n].vertex);
   check_cancel(observer);
@@ -114,10 +116,7 @@ NodeOptimizer::Impl::Impl(const TriMesh& mesh, const Layout& layout,
   // computes it beside the field (PipelineOptions::order_vertices); otherwise it is computed
   // here beside the initial solve (the future waits in its destructor if that throws).
   std::future<std::vector<int>> vertex_order;
-  if (!no.vertex_ordering)
-    options.order_vertices = false;
-  else if (!options.param.vertex_order &&
-           !pipeline_orders_vertices(options, original_geometry.n_faces))
+  if (!options.param.vertex_order && !pipeline_orders_vertices(options, original_geometry.n_faces))
     vertex_order = std::async(std::launch::async,
                               [this] { return vertex_nested_dissection(original_geometry); });
   if (start && pipeline_matches(*start, mesh, layout)) {
@@ -137,7 +136,7 @@ NodeOptimizer::Impl::Impl(const TriMesh& mesh, const Layout& layout,
       options.param.vertex_order = std::make_shared<const std::vector<int>>(std::move(order));
       current.pipeline->set_param_vertex_order(options.param.vertex_order);
     }
-  } else if (no.vertex_ordering && !options.param.vertex_order) {
+  } else if (!options.param.vertex_order) {
     options.param.vertex_order = current.pipeline->options().param.vertex_order;
   }
   fewest_folds_count = current.foldovers;
@@ -157,7 +156,7 @@ NodeOptimizer::Impl::Impl(const TriMesh& mesh, const Layout& layout,
 
 std::shared_ptr<Pipeline> NodeOptimizer::Impl::switched_pipeline(const TriMesh& m, const Layout& l,
                                                                  bool own_solvers) {
-  if (no.reuse_field && current.pipeline->field()) {
+  if (no.run.reuse_field && current.pipeline->field()) {
     ++counters.relayouts;
     auto p = std::make_shared<Pipeline>(m, l, *current.pipeline);
     if (own_solvers) p->unshare_solvers();
@@ -165,6 +164,10 @@ std::shared_ptr<Pipeline> NodeOptimizer::Impl::switched_pipeline(const TriMesh& 
   }
   ++counters.fresh_pipelines;
   return std::make_shared<Pipeline>(m, l, options, false);
+}
+
+bool NodeOptimizer::Impl::parallel(int threads) const {
+  return no.run.threads >= threads && std::thread::hardware_concurrency() >= 2;
 }
 
 Evaluation NodeOptimizer::Impl::evaluate_switched(const TriMesh& m, const Layout& l) {
@@ -181,7 +184,7 @@ NodeOptimizer::NodeOptimizer(const TriMesh& mesh, const Layout& layout,
   // Symmetric optimization: what moves single nodes off (symmetric_step.h).
   const NodeOptOptions node_options = symmetric_node_options(given_options);
   std::optional<SeparateNodesResult> separated;
-  if (node_options.separate_crowded_nodes) separated = separate_movable_nodes(mesh, layout);
+  if (node_options.moves.separate_crowded_nodes) separated = separate_movable_nodes(mesh, layout);
   const bool moved = separated && !separated->moved_nodes.empty();
   impl_ = std::make_unique<Impl>(mesh, moved ? separated->layout : layout, options, node_options,
                                  observer, std::move(start));

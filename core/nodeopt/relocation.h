@@ -108,7 +108,7 @@ int choose_relocation_vertex(const TriMesh& mesh, const TriMesh& original,
 //! Vertices a moving node may not be relocated onto (size #V): other nodes' vertices, boundary
 //! vertices, vertices of feature edges, and vertices of arcs not incident to node \p node_index
 //! (an index into layout.nodes); with \p keep_apart also the 1-rings of the other nodes
-//! (next_to_other_nodes, NodeOptOptions::keep_nodes_apart).
+//! (next_to_other_nodes, NodeOptOptions::Moves::keep_nodes_apart).
 std::vector<char> forbidden_relocation_vertices(const TriMesh& mesh, const Layout& layout,
                                                 int node_index, bool keep_apart = false);
 //! Vertex \p v holds another node than \p node_index, or lies on an arc not incident to it

@@ -16,9 +16,10 @@ bool fell_back(const NodeOptResult& r);
 //! every state tried; an untangled map keeps its state's parametric cones).
 bool unembedded(const NodeOptResult& r);
 
-//! The keep-apart retry (NodeOptOptions::keep_nodes_apart) is wanted after \p first, not stopped
-//! early, when fold-overs remain, only the untangling removed them, or the removal fell back to
-//! an earlier state (whether the user left the choice to the default is the caller's check).
+//! The keep-apart retry (NodeOptOptions::Moves::keep_nodes_apart) is wanted after \p first, not
+//! stopped early, when fold-overs remain, only the untangling removed them, or the removal fell
+//! back to an earlier state (whether the user left the choice to the default is the caller's
+//! check).
 bool wants_keep_apart_retry(const NodeOptResult& first);
 
 //! The keep-apart retry \p run replaces \p first when it ends with fewer fold-overs; at as many,

@@ -71,11 +71,11 @@ std::shared_ptr<const NodeSymmetry> make_node_symmetry(const TriMesh& mesh, cons
 }
 
 NodeOptOptions symmetric_node_options(const NodeOptOptions& options) {
-  if (!options.symmetry) return options;
+  if (!options.moves.symmetry) return options;
   NodeOptOptions out = options;
-  out.hop_polish = false;
-  out.slide_on_curves = false;
-  out.separate_crowded_nodes = false;
+  out.polish.enabled = false;
+  out.moves.slide_on_curves = false;
+  out.moves.separate_crowded_nodes = false;
   return out;
 }
 

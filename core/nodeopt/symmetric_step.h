@@ -19,7 +19,7 @@
 
 namespace qs {
 
-//! What the node optimizer keeps symmetric (NodeOptOptions::symmetry).
+//! What the node optimizer keeps symmetric (NodeOptOptions::Moves::symmetry).
 struct NodeSymmetry {
   MirrorPlane plane;
   //! Per layout node index: the index of its mirror node (itself for a node on the plane).
@@ -35,10 +35,10 @@ std::shared_ptr<const NodeSymmetry> make_node_symmetry(const TriMesh& mesh, cons
                                                        const MirrorPlane& plane,
                                                        const SymmetryPairOptions& options = {});
 
-//! \p options with what moves single nodes turned off when options.symmetry is set: the hop
-//! polish (hop_polish, and with it hop_cones_first), sliding along curves (slide_on_curves: nodes
-//! on the boundary or a feature curve stay) and the separation of crowded nodes
-//! (separate_crowded_nodes). Unchanged without symmetry.
+//! \p options with what moves single nodes turned off when options.moves.symmetry is set: the
+//! hop polish (polish.enabled, with its cone sweep before the descent), sliding along curves
+//! (moves.slide_on_curves: nodes on the boundary or a feature curve stay) and the separation of
+//! crowded nodes (moves.separate_crowded_nodes). Unchanged without symmetry.
 NodeOptOptions symmetric_node_options(const NodeOptOptions& options);
 
 //! A node's target in one symmetric descent step.

@@ -332,9 +332,10 @@ struct WmOptimizer::Impl {
       OrientationOptions used;
       try {
         s.pipeline = oriented(st, used);
-      } catch (const Cancelled&) {
-        throw;
-      } catch (const QsError& e) {
+      } catch (const InfeasibleLayoutError& e) {
+        result.orientation.message = e.what();
+        return;
+      } catch (const SolverError& e) {
         result.orientation.message = e.what();
         return;
       }

@@ -219,7 +219,7 @@ Reduction eliminate_constraints(const ConstraintSystem& sys, double tolerance) {
     for (size_t i = 0; i < incompatible.size() && i < 8; ++i)
       ss << (i ? "; " : "") << incompatible[i];
     if (incompatible.size() > 8) ss << "; …";
-    throw InvalidInputError(ss.str());
+    throw InfeasibleLayoutError(ss.str());
   }
 
   // Pass 3: substitute pass 2's expressions into pass 1's, once each.

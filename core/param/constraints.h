@@ -60,7 +60,7 @@ struct Reduction {
 //! is of this form. Pivots: the largest |coefficient| of the reduced row (ties, the usual case
 //! with coefficients ±1, go to the variable used by the fewest eliminated expressions, i.e. a
 //! Markowitz choice that keeps Z sparse and the elimination fast). Redundant rows (0 = 0 after
-//! reduction) are counted and dropped. \throw InvalidInputError "incompatible constraints (k):
+//! reduction) are counted and dropped. \throw InfeasibleLayoutError "incompatible constraints (k):
 //! <origins>" naming every incompatible row's origin (e.g. "arc 7 (node connection)") when a
 //! row reduces to 0 = c with |c| > tolerance·max(1, max |coefficient|); InvalidInputError when
 //! a row names a variable outside [0, variables).

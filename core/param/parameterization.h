@@ -56,7 +56,7 @@ struct ParamOptions {
   //! translations and the long columns of merged unknowns last) instead of AMD on the matrix.
   //! The vertex order does not depend on the layout: a Pipeline computes it once for all its
   //! solvers and the pipelines continued from it (PipelineOptions::order_vertices), as does the
-  //! node optimizer on smaller meshes (NodeOptOptions::vertex_ordering). Takes precedence over
+  //! node optimizer on smaller meshes (optimize_nodes). Takes precedence over
   //! wedge_ordering.
   std::shared_ptr<const std::vector<int>> vertex_order;
   //! Runs independent parts of the stage on a second thread: the layout labels beside the cut
@@ -106,7 +106,7 @@ class ParamSolver {
   //! analysis starts (on the second thread, ParamOptions::second_thread) and the first
   //! factorization is the next solve()'s or optimal_field_rotation()'s. For a field whose
   //! rotation is still to be chosen, a first solve would be thrown away.
-  //! \throw TopologyError, InvalidInputError (incompatible constraints naming arcs),
+  //! \throw TopologyError, InfeasibleLayoutError (incompatible constraints naming arcs),
   //! SolverError.
   ParamSolver(const TriMesh& mesh, const GeometryCache& geometry, const Layout& layout,
               const LayoutTopology& topology, const std::vector<int>& period_jump,

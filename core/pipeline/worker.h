@@ -61,7 +61,7 @@ struct WorkerOptions {
   //! fails or falls back (as `quadsketch-cli optimize` does).
   std::optional<bool> keep_nodes_apart;
   //! Nodes sketched next to another node are moved apart before the node optimization
-  //! (NodeOptOptions::separate_crowded_nodes, --separate-nodes).
+  //! (NodeOptOptions::Moves::separate_crowded_nodes, --separate-nodes).
   bool separate_nodes = false;
   //! Without node optimization: when the parameterization folds, solve it again with strict
   //! orientation constraints (`optimize --no-node-opt --orientation`); the node optimization
