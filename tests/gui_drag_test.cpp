@@ -17,6 +17,7 @@
 
 #include "app/gui/editor.h"
 #include "app/gui/pipeline_job.h"
+#include "tests/gui_editor_fixture.h"
 #include "tests/scoped_env.h"
 
 namespace qs::app {
@@ -31,23 +32,10 @@ class GuiDrag : public ::testing::Test {
  protected:
   GuiDrag()
       : sandbox_("qs_gui_drag", ::testing::UnitTest::GetInstance()->current_test_info()->name()) {}
-  static EditorConfig config() {
-    EditorConfig c;
-    c.assets_dir = kAssets.string();
-    c.worker_nice = 0;
-    c.remember_recent = false;
-    c.step = editor_step_function(0);
-    return c;
-  }
+  static EditorConfig config() { return test::editor_test_config(); }
   static bool poll_until(Editor& editor, const std::function<bool()>& done,
                          std::chrono::seconds timeout = 120s) {
-    const auto end = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < end) {
-      editor.poll();
-      if (done()) return true;
-      std::this_thread::sleep_for(2ms);
-    }
-    return false;
+    return test::poll_editor_until(editor, done, timeout);
   }
   // The next drag position of node \p id from its vertex: a free neighbouring vertex farther
   // from \p origin, at which the layout stays valid. Moves the node there; false when there is

@@ -21,6 +21,7 @@
 #include "app/gui/plot_ticks.h"
 #include "app/gui/ui_text.h"
 #include "core/layout/layout_io.h"
+#include "tests/gui_editor_fixture.h"
 #include "tests/scoped_env.h"
 #ifdef QS_TEST_RENDER
 #define GLFW_INCLUDE_NONE
@@ -47,24 +48,10 @@ class GuiEditor : public ::testing::Test {
         dir_(sandbox_.dir()) {
     fs::create_directories(dir_ / "home" / "Documents");
   }
-  static EditorConfig config() {
-    EditorConfig c;
-    c.assets_dir = kAssets.string();
-    c.worker_nice = 0;
-    c.remember_recent = false;
-    c.step = editor_step_function(0);
-    return c;
-  }
-  // Polls until \p done or \p timeout; false on timeout.
+  static EditorConfig config() { return test::editor_test_config(); }
   static bool poll_until(Editor& editor, const std::function<bool()>& done,
                          std::chrono::seconds timeout = 120s) {
-    const auto end = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < end) {
-      editor.poll();
-      if (done()) return true;
-      std::this_thread::sleep_for(5ms);
-    }
-    return false;
+    return test::poll_editor_until(editor, done, timeout);
   }
   static bool finished(const Editor& editor) {
     const SnapshotPtr& s = editor.job.latest();

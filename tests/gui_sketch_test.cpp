@@ -24,6 +24,7 @@
 #include "core/mesh/mesh_io.h"
 #include "core/nodeopt/symmetric_step.h"
 #include "tests/fixtures.h"
+#include "tests/gui_editor_fixture.h"
 #include "tests/scoped_env.h"
 #ifdef QS_TEST_RENDER
 #include "render/guide_layer.h"
@@ -45,23 +46,10 @@ class GuiSketch : public ::testing::Test {
   GuiSketch()
       : sandbox_("qs_gui_sketch", ::testing::UnitTest::GetInstance()->current_test_info()->name()),
         dir_(sandbox_.dir()) {}
-  static EditorConfig config() {
-    EditorConfig c;
-    c.assets_dir = kAssets.string();
-    c.worker_nice = 0;
-    c.remember_recent = false;
-    c.step = editor_step_function(0);
-    return c;
-  }
+  static EditorConfig config() { return test::editor_test_config(); }
   static bool poll_until(Editor& editor, const std::function<bool()>& done,
                          std::chrono::seconds timeout = 60s) {
-    const auto end = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < end) {
-      editor.poll();
-      if (done()) return true;
-      std::this_thread::sleep_for(2ms);
-    }
-    return false;
+    return test::poll_editor_until(editor, done, timeout);
   }
   // The example mesh with an empty layout and mirrored sketching about x = 0.
   static void start_mirrored(Editor& editor) {
