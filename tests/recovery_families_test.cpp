@@ -345,7 +345,7 @@ TEST(RecoveryFamilies, Valence5PrismOnIcosphere) {
 //   those neighbours. The cone passes find every such valence-5 node with its exact corner as
 //   first target, but moving them onto their corners (all relocations undone) gives E 5.23, 3.08,
 //   4.87, above the 3.01, 2.68, 2.51 the descent reached, so the collective pass rejects it; the
-//   cone pass before the descent (hop_cones_first) searches hop_cone_rings = 2 rings and finds
+//   cone pass before the descent searches tuning.hop_cone_rings = 2 rings and finds
 //   1, 1, 0 of the nodes displaced 3 rings. Measured: hop_cone_rings = 3 ends at 0 (exact), 2.47,
 //   1.63; sharp_edges_as_curves at 4.56, 13.1, 0 (exact); genus2_polycube(8) (3 rings = 3/8 of a
 //   patch side) at 0.0014, 0.030, 0.040 E_init.
