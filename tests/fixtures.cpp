@@ -115,6 +115,19 @@ LayoutArc make_arc(int id, int from, int to, std::vector<int> path) {
   return a;
 }
 
+MeshAndLayout bumpy_rounded_cube() {
+  MeshAndLayout ex = cube_sphere(24, Vec3(1, 1, 1), /*project=*/false);
+  for (const auto vh : ex.mesh.vertices()) {
+    const Vec3 p = ex.mesh.point(vh);
+    Vec3 q = p;
+    q.normalize();
+    const double bump = 0.015 * std::sin(23.0 * p[0] + 1.0) * std::sin(19.0 * p[1] + 2.0) *
+                        std::sin(17.0 * p[2] + 3.0);
+    ex.mesh.set_point(vh, (0.3 * p + 0.7 * std::sqrt(3.0) * q) * (1.0 + bump));
+  }
+  return ex;
+}
+
 MeshAndLayout cube_sphere(int k, Vec3 radii, bool project) {
   MeshAndLayout out;
   TriMesh& mesh = out.mesh;

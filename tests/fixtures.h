@@ -52,6 +52,10 @@ LayoutArc make_arc(int id, int from, int to, std::vector<int> path);
 //! radii (radii {1,1,1}: unit sphere; project=false keeps the cube [-1,1]^3). Layout: the 8
 //! cube corners (valence 3) and the 12 cube edges (each a path of k mesh edges): 6 patches.
 MeshAndLayout cube_sphere(int k, Vec3 radii = Vec3(1, 1, 1), bool project = true);
+//! cube_sphere(24) rounded halfway to the sphere (0.3 cube + 0.7 sphere) with a bumpy surface
+//! (radial sin·sin·sin bumps of 1.5 %): its natural cross field has dozens of close
+//! singularity pairs besides the corners.
+MeshAndLayout bumpy_rounded_cube();
 
 //! Icosahedron subdivided \p subdivisions times (each triangle into 4), projected onto the
 //! ellipsoid with the given radii: 20·4^subdivisions faces, vertices of valence 5 and 6 that

@@ -435,15 +435,7 @@ TEST_F(GuiSketch, FieldHintsAreComputedInTheBackgroundOncePerMesh) {
 // rounded cube, a scale of 0 shows every singularity of the field, the default fewer, with the
 // same index sum; a change shows after the next poll without a new field computation.
 TEST_F(GuiSketch, HintScaleHidesClosePairs) {
-  auto bumpy = test::cube_sphere(24, Vec3(1, 1, 1), /*project=*/false);
-  for (const auto vh : bumpy.mesh.vertices()) {
-    const Vec3 p = bumpy.mesh.point(vh);
-    Vec3 q = p;
-    q.normalize();
-    const double bump = 0.015 * std::sin(23.0 * p[0] + 1.0) * std::sin(19.0 * p[1] + 2.0) *
-                        std::sin(17.0 * p[2] + 3.0);
-    bumpy.mesh.set_point(vh, (0.3 * p + 0.7 * std::sqrt(3.0) * q) * (1.0 + bump));
-  }
+  const auto bumpy = test::bumpy_rounded_cube();
   const fs::path path = dir_ / "bumpy_cube.obj";
   save_mesh_obj(bumpy.mesh, path.string());
   Editor editor(config());

@@ -179,15 +179,7 @@ std::vector<double> edge_distances(const TriMesh& mesh, int source) {
 // natural field. At the scale of a tenth of the diagonal most of them cancel, the index sum
 // stays 4χ, and no two singularities of opposite index closer than the scale remain.
 TEST(NaturalField, BumpySurfaceLosesItsClosePairsAtTheLayoutScale) {
-  auto ex = test::cube_sphere(24, Vec3(1, 1, 1), /*project=*/false);
-  for (const auto vh : ex.mesh.vertices()) {
-    const Vec3 p = ex.mesh.point(vh);
-    Vec3 q = p;
-    q.normalize();
-    const double bump = 0.015 * std::sin(23.0 * p[0] + 1.0) * std::sin(19.0 * p[1] + 2.0) *
-                        std::sin(17.0 * p[2] + 3.0);
-    ex.mesh.set_point(vh, (0.3 * p + 0.7 * std::sqrt(3.0) * q) * (1.0 + bump));
-  }
+  const auto ex = test::bumpy_rounded_cube();
   const GeometryCache g = build_geometry(ex.mesh);
   const NaturalField field = compute_natural_field(ex.mesh, g);
   ASSERT_GT(field.singularities.size(), 24u) << "the bumps no longer perturb the field";
@@ -203,9 +195,11 @@ TEST(NaturalField, BumpySurfaceLosesItsClosePairsAtTheLayoutScale) {
   EXPECT_EQ(index_sum(at_scale), 8);
   for (const auto& s : at_scale.singularities) {
     const std::vector<double> dist = edge_distances(ex.mesh, s.vertex);
-    for (const auto& t : at_scale.singularities)
-      if (t.index == -s.index)
+    for (const auto& t : at_scale.singularities) {
+      if (t.index == -s.index) {
         EXPECT_GE(dist[t.vertex], radius) << "vertices " << s.vertex << " and " << t.vertex;
+      }
+    }
   }
 }
 

@@ -8,20 +8,6 @@
 
 namespace qs::app {
 
-namespace {
-
-double diagonal(const TriMesh& mesh) {
-  if (mesh.n_vertices() == 0) return 0.0;
-  Vec3 lo = mesh.point(*mesh.vertices_begin()), hi = lo;
-  for (const auto vh : mesh.vertices()) {
-    lo.minimize(mesh.point(vh));
-    hi.maximize(mesh.point(vh));
-  }
-  return (hi - lo).norm();
-}
-
-}  // namespace
-
 void FieldHints::poll(const Document& doc, int nice) {
   std::optional<std::shared_ptr<const NaturalField>> result;
   std::string error;
@@ -57,7 +43,7 @@ void FieldHints::poll(const Document& doc, int nice) {
     pairing_scale_ = scale_;
     const std::shared_ptr<const TriMesh> mesh = doc.mesh;
     const std::shared_ptr<const NaturalField> field = field_;
-    const double radius = scale_ * diagonal(*mesh);
+    const double radius = scale_ * field->bbox_diagonal;
     pairing_.start(++pairing_requests_, [mesh, field, radius] {
       return cancel_close_pairs(*mesh, field->singularities, radius);
     });

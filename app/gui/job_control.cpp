@@ -321,14 +321,17 @@ void JobControl::send_live(const Layout& layout, Clock::time_point event) {
   ++live_stats_.sent;
 }
 
+void JobControl::begin_live() {
+  if (live_.active) return;
+  held_ = {};
+  stop_seq_ = 0;
+  live_ = {};
+  live_.active = true;
+}
+
 void JobControl::live_request(const Layout& layout, Clock::time_point event) {
   ++live_stats_.requests;
-  if (!live_.active) {
-    held_ = {};
-    stop_seq_ = 0;
-    live_ = {};
-    live_.active = true;
-  }
+  begin_live();
   live_.invalid = false;
   if (live_.inflight_seq == 0) {
     send_live(layout, event);
@@ -339,12 +342,7 @@ void JobControl::live_request(const Layout& layout, Clock::time_point event) {
 }
 
 void JobControl::live_invalid() {
-  if (!live_.active) {
-    held_ = {};
-    stop_seq_ = 0;
-    live_ = {};
-    live_.active = true;
-  }
+  begin_live();
   live_.invalid = true;
   live_.pending.reset();
 }

@@ -146,6 +146,8 @@ class JobControl {
   void start_fresh(const Document& doc);
   //! Sends the live solve of \p layout (SetLayout, the options without node optimization, Step).
   void send_live(const Layout& layout, Clock::time_point event);
+  //! Starts a live drag session (drops a held run result and a pending stop) unless one is on.
+  void begin_live();
   //! Reads the end of the live solve in flight from latest_.
   void poll_live(const Document& doc);
 

@@ -118,6 +118,7 @@ NaturalField compute_natural_field(const TriMesh& mesh, const GeometryCache& g,
   out.theta.resize(nf);
   for (int f = 0; f < nf; ++f) out.theta[f] = 0.25 * std::atan2(z[2 * f + 1], z[2 * f]);
   out.direction = field_directions(g, out.theta);
+  out.bbox_diagonal = g.bbox_diagonal;
   out.quarter_index = field_quarter_indices(g, out.theta);
   for (int v = 0; v < g.n_vertices; ++v)
     if (out.quarter_index[v] != 0) out.singularities.push_back({v, out.quarter_index[v]});

@@ -55,6 +55,7 @@ struct NaturalField {
   std::vector<int> quarter_index;
   std::vector<FieldSingularity> singularities;  //!< the vertices with a non-zero index
   FieldConstraints constraints;                 //!< the direction constraints used
+  double bbox_diagonal = 0;  //!< the mesh's bounding-box diagonal (GeometryCache), model units
 };
 
 //! The singularities of \p singularities that remain at the length scale \p radius (model
